@@ -1,0 +1,156 @@
+#include "stokesrods/io/build_model.h"
+
+#include <cmath>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "stokesrods/rod/geometry.h"
+#include "stokesrods/sim/contact_forces.h"
+#include "stokesrods/sim/observables.h"
+#include "stokesrods/sim/state.h"
+
+namespace stokesrods {
+namespace {
+
+Matrix3X RestShape(const RodConfig& rod) {
+  if (rod.shape == "straight") return StraightNodes(rod.nodes, rod.axis_length, rod.base);
+  if (rod.shape == "points") {
+    Matrix3X x(3, static_cast<Eigen::Index>(rod.points.size()));
+    for (std::size_t i = 0; i < rod.points.size(); ++i) x.col(static_cast<Eigen::Index>(i)) = rod.points[i];
+    return x;
+  }
+  HelixGeometry g;
+  g.nodes = rod.nodes;
+  g.axis_length = rod.axis_length;
+  g.pitch = rod.pitch;
+  g.helix_radius = rod.helix_radius;
+  g.right_handed = rod.handedness == "right";
+  g.base = rod.base;
+  return HelixNodes(g);
+}
+
+FluidModel ParseFluidModel(const std::string& name) {
+  if (name == "rss") return FluidModel::kRss;
+  if (name == "lsbt") return FluidModel::kLsbt;
+  if (name == "rft") return FluidModel::kRft;
+  return FluidModel::kNone;
+}
+
+}  // namespace
+
+Model BuildModel(const Config& config) {
+  Model model;
+  model.fluid.model = ParseFluidModel(config.fluid.model);
+  model.fluid.viscosity = config.fluid.viscosity;
+  model.fluid.regularization = config.fluid.regularization;
+  model.coupling =
+      config.fluid.coupling == "explicit" ? FluidCoupling::kExplicit : FluidCoupling::kImplicit;
+  model.contact = config.contact.enabled;
+  model.gravity = config.gravity.acceleration;
+  model.damping = config.solver.damping;
+  model.newton.tolerance = config.solver.newton_tolerance;
+  model.newton.max_iterations = config.solver.newton_max_iterations;
+  model.newton.max_contact_rounds = config.contact.max_rounds;
+  model.newton.contact_tolerance = config.contact.tolerance;
+
+  for (const RodConfig& rc : config.rods) {
+    RodModel rod;
+    rod.radius = rc.radius;
+    rod.density = rc.density;
+    const double area = kPi * rc.radius * rc.radius;
+    const double inertia = kPi * std::pow(rc.radius, 4) / 4.0;
+    const double shear = rc.young_modulus / (2.0 * (1.0 + rc.poisson_ratio));
+    rod.axial_stiffness = rc.young_modulus * area;
+    rod.bending_stiffness = rc.young_modulus * inertia;
+    rod.twisting_stiffness = shear * 2.0 * inertia;  // J = π r0⁴ / 2 = 2 I
+    rod.rest_positions = RestShape(rc);
+    rod.clamped_nodes = rc.clamped_nodes;
+    rod.axis_length = rc.axis_length;
+    rod.helix_radius = rc.shape == "helix" ? rc.helix_radius : 0.0;
+    // ω about +ẑ; omega_bar = ω μ l0⁴ / EI (SPEC).
+    rod.omega = rc.omega ? *rc.omega
+                : rc.omega_bar ? *rc.omega_bar * rod.bending_stiffness /
+                                     (config.fluid.viscosity * std::pow(rc.axis_length, 4))
+                               : 0.0;
+    for (const PointLoadConfig& l : rc.loads) rod.loads.push_back({l.node, l.force});
+    FinalizeRod(&rod);
+    // The imposed rotation vector is +ω ẑ: the first material frame turns about ẑ, i.e. about
+    // its own tangent t⁰ at the rate ω (ẑ · t⁰) (t⁰ = −ẑ for the hanging helix: θ0 decreases).
+    const Vec3 t0 = (rod.rest_positions.col(1) - rod.rest_positions.col(0)).normalized();
+    rod.twist_rate = rod.omega * t0.z();
+    model.rods.push_back(std::move(rod));
+  }
+  FinalizeLayout(&model);
+
+  if (model.fluid.model == FluidModel::kLsbt || model.fluid.model == FluidModel::kRft)
+    throw ConfigError(config.file, "fluid.model",
+                      fmt::format("\"{}\" is not available yet in this version (use \"rss\" or "
+                                  "\"none\")", config.fluid.model));
+
+  // Rods overlapping at the start.
+  for (std::size_t a = 0; a < model.rods.size(); ++a)
+    for (std::size_t b = a + 1; b < model.rods.size(); ++b) {
+      Model pair;
+      pair.rods = {model.rods[a], model.rods[b]};
+      FinalizeLayout(&pair);
+      const double d = MinDistanceBetweenRods(pair, MakeRestState(pair).q);
+      const double contact = model.rods[a].radius + model.rods[b].radius;
+      if (d < contact)
+        throw ConfigError(config.file, fmt::format("rods.{}.base", b + 1),
+                          fmt::format("rod {} overlaps rod {} at the start: their center lines are "
+                                      "{:.4g} m apart, less than r_a + r_b = {:.4g} m",
+                                      b + 1, a + 1, d, contact));
+    }
+  return model;
+}
+
+RunPlan MakeRunPlan(const Config& config, const Model& model) {
+  RunPlan plan;
+  plan.name = config.run.name;
+  plan.output_dir = config.run.output;
+  plan.static_mode = config.run.mode == "static";
+  plan.time_step = config.run.time_step;
+  plan.frames = config.run.frames;
+  const Scales scales = CalcScales(model);
+  plan.duration = config.run.duration ? *config.run.duration
+                  : config.run.t_bar_end ? *config.run.t_bar_end * scales.time
+                                         : 0.0;
+  plan.output_interval = config.run.output_interval
+                             ? *config.run.output_interval
+                             : std::max(plan.time_step, plan.duration / 100.0);
+  plan.checkpoint_interval = config.run.checkpoint_interval
+                                 ? *config.run.checkpoint_interval
+                                 : std::max(plan.time_step, plan.duration / 10.0);
+  return plan;
+}
+
+std::string DerivedJson(const Config& config, const Model& model) {
+  const Scales scales = CalcScales(model);
+  nlohmann::json d;
+  d["time_scale"] = scales.time;
+  d["force_scale"] = scales.force;
+  for (std::size_t r = 0; r < model.rods.size(); ++r) {
+    const RodModel& rod = model.rods[r];
+    const double l0 = rod.axis_length;
+    d["EI"].push_back(rod.bending_stiffness);
+    d["GJ"].push_back(rod.twisting_stiffness);
+    d["EA"].push_back(rod.axial_stiffness);
+    d["omega"].push_back(rod.omega);
+    d["omega_bar"].push_back(rod.omega * config.fluid.viscosity * std::pow(l0, 4) /
+                             rod.bending_stiffness);
+    d["arc_length"].push_back(rod.rest_edge_length.sum());
+    d["node_mass"].push_back(rod.mass(NodeDof(rod.num_nodes() / 2)));
+    d["edge_length_min"].push_back(rod.rest_edge_length.minCoeff());
+    d["edge_length_max"].push_back(rod.rest_edge_length.maxCoeff());
+  }
+  const RunPlan plan = MakeRunPlan(config, model);
+  d["duration"] = plan.duration;
+  d["t_bar_end"] = plan.duration / scales.time;
+  d["output_interval"] = plan.output_interval;
+  d["checkpoint_interval"] = plan.checkpoint_interval;
+  d["steps"] = plan.static_mode ? 0.0 : std::ceil(plan.duration / plan.time_step - 1e-9);
+  return d.dump(2);
+}
+
+}  // namespace stokesrods

@@ -1,0 +1,373 @@
+#include "stokesrods/io/config.h"
+
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+namespace stokesrods {
+
+ConfigError::ConfigError(const std::string& file, const std::string& key,
+                         const std::string& problem)
+    : std::runtime_error(fmt::format("{}: {}: {}", file, key.empty() ? "(file)" : key, problem)),
+      file_(file),
+      key_(key) {}
+
+// ---- The field lists: one per struct. -------------------------------------------------------
+
+template <class V>
+void VisitFields(RunConfig& c, V& v) {
+  v("name", c.name);
+  v("output", c.output);
+  v("mode", c.mode);
+  v("duration", c.duration);
+  v("t_bar_end", c.t_bar_end);
+  v("time_step", c.time_step);
+  v("output_interval", c.output_interval);
+  v("frames", c.frames);
+  v("checkpoint_interval", c.checkpoint_interval);
+}
+template <class V>
+void VisitFields(FluidConfig& c, V& v) {
+  v("model", c.model);
+  v("viscosity", c.viscosity);
+  v("regularization", c.regularization);
+  v("coupling", c.coupling);
+}
+template <class V>
+void VisitFields(ContactConfig& c, V& v) {
+  v("enabled", c.enabled);
+  v("tolerance", c.tolerance);
+  v("max_rounds", c.max_rounds);
+}
+template <class V>
+void VisitFields(GravityConfig& c, V& v) {
+  v("acceleration", c.acceleration);
+}
+template <class V>
+void VisitFields(SolverConfig& c, V& v) {
+  v("newton_tolerance", c.newton_tolerance);
+  v("newton_max_iterations", c.newton_max_iterations);
+  v("damping", c.damping);
+}
+template <class V>
+void VisitFields(PointLoadConfig& c, V& v) {
+  v("node", c.node);
+  v("force", c.force);
+}
+template <class V>
+void VisitFields(RodConfig& c, V& v) {
+  v("shape", c.shape);
+  v("radius", c.radius);
+  v("young_modulus", c.young_modulus);
+  v("poisson_ratio", c.poisson_ratio);
+  v("density", c.density);
+  v("nodes", c.nodes);
+  v("axis_length", c.axis_length);
+  v("pitch", c.pitch);
+  v("helix_radius", c.helix_radius);
+  v("handedness", c.handedness);
+  v("base", c.base);
+  v("clamped_nodes", c.clamped_nodes);
+  v("omega", c.omega);
+  v("omega_bar", c.omega_bar);
+  v("points", c.points);
+  v("loads", c.loads);
+}
+
+namespace {
+
+// ---- Reading: types checked here, values in Validate (config_validate.cc). ------------------
+
+class Reader {
+ public:
+  Reader(const toml::table* table, std::string prefix, const std::string& file)
+      : table_(table), prefix_(std::move(prefix)), file_(file) {}
+
+  template <class T>
+  void operator()(const char* key, T& field) {
+    known_.insert(key);
+    if (table_ == nullptr) return;
+    const toml::node* node = table_->get(key);
+    if (node != nullptr) Read(*node, Path(key), &field);
+  }
+
+  /// Every key of the table must have been visited.
+  void RejectUnknownKeys() const {
+    if (table_ == nullptr) return;
+    for (const auto& [key, node] : *table_) {
+      if (known_.count(std::string(key.str())) == 0) {
+        std::string list;
+        for (const std::string& k : known_) list += (list.empty() ? "" : ", ") + k;
+        throw ConfigError(file_, Path(std::string(key.str())),
+                          fmt::format("unknown key (known here: {})", list));
+      }
+    }
+  }
+
+ private:
+  std::string Path(const std::string& key) const {
+    return prefix_.empty() ? key : prefix_ + "." + key;
+  }
+  [[noreturn]] void Wrong(const std::string& path, const char* expected,
+                          const toml::node& node) const {
+    throw ConfigError(file_, path,
+                      fmt::format("expected {}, got {}", expected, toml::impl::node_type_friendly_names
+                                      [static_cast<int>(node.type())]));
+  }
+  void Read(const toml::node& n, const std::string& path, std::string* out) const {
+    if (!n.is_string()) Wrong(path, "a string", n);
+    *out = *n.value<std::string>();
+  }
+  void Read(const toml::node& n, const std::string& path, double* out) const {
+    if (!n.is_number()) Wrong(path, "a number", n);
+    *out = *n.value<double>();
+  }
+  void Read(const toml::node& n, const std::string& path, std::optional<double>* out) const {
+    double v = 0.0;
+    Read(n, path, &v);
+    *out = v;
+  }
+  void Read(const toml::node& n, const std::string& path, int* out) const {
+    if (!n.is_integer()) Wrong(path, "an integer", n);
+    const std::int64_t v = *n.value<std::int64_t>();
+    if (v < -1000000000 || v > 1000000000) throw ConfigError(file_, path, "integer out of range");
+    *out = static_cast<int>(v);
+  }
+  void Read(const toml::node& n, const std::string& path, bool* out) const {
+    if (!n.is_boolean()) Wrong(path, "true or false", n);
+    *out = *n.value<bool>();
+  }
+  void Read(const toml::node& n, const std::string& path, Vec3* out) const {
+    const toml::array* a = n.as_array();
+    if (a == nullptr || a->size() != 3) Wrong(path, "an array of 3 numbers", n);
+    for (int k = 0; k < 3; ++k) Read(*a->get(k), fmt::format("{}[{}]", path, k), &(*out)(k));
+  }
+  void Read(const toml::node& n, const std::string& path, std::vector<Vec3>* out) const {
+    const toml::array* a = n.as_array();
+    if (a == nullptr) Wrong(path, "an array of [x, y, z] points", n);
+    out->assign(a->size(), Vec3::Zero());
+    for (std::size_t i = 0; i < a->size(); ++i)
+      Read(*a->get(i), fmt::format("{}[{}]", path, i), &(*out)[i]);
+  }
+  template <class S>
+  void Read(const toml::node& n, const std::string& path, std::vector<S>* out) const {
+    const toml::array* a = n.as_array();
+    if (a == nullptr) Wrong(path, "an array of tables", n);
+    out->assign(a->size(), S{});
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      const toml::table* t = a->get(i)->as_table();
+      if (t == nullptr) Wrong(fmt::format("{}[{}]", path, i), "a table", *a->get(i));
+      Reader inner(t, fmt::format("{}[{}]", path, i), file_);
+      VisitFields((*out)[i], inner);
+      inner.RejectUnknownKeys();
+    }
+  }
+
+  const toml::table* table_;
+  std::string prefix_;
+  const std::string& file_;
+  std::set<std::string> known_;
+};
+
+// ---- Writing the resolved configuration. ----------------------------------------------------
+
+class Writer {
+ public:
+  explicit Writer(toml::table* table) : table_(table) {}
+  template <class T>
+  void operator()(const char* key, T& field) {
+    Write(key, field);
+  }
+
+ private:
+  void Write(const char* key, const std::string& v) { table_->insert_or_assign(key, v); }
+  void Write(const char* key, double v) { table_->insert_or_assign(key, v); }
+  void Write(const char* key, int v) { table_->insert_or_assign(key, v); }
+  void Write(const char* key, bool v) { table_->insert_or_assign(key, v); }
+  void Write(const char* key, const std::optional<double>& v) {
+    if (v) table_->insert_or_assign(key, *v);
+  }
+  static toml::array Array(const Vec3& v) { return toml::array{v.x(), v.y(), v.z()}; }
+  void Write(const char* key, const Vec3& v) { table_->insert_or_assign(key, Array(v)); }
+  void Write(const char* key, std::vector<Vec3>& v) {
+    if (v.empty()) return;
+    toml::array a;
+    for (const Vec3& p : v) a.push_back(Array(p));
+    table_->insert_or_assign(key, std::move(a));
+  }
+  template <class S>
+  void Write(const char* key, std::vector<S>& v) {
+    if (v.empty()) return;
+    toml::array a;
+    for (S& s : v) {
+      toml::table t;
+      Writer inner(&t);
+      VisitFields(s, inner);
+      a.push_back(std::move(t));
+    }
+    table_->insert_or_assign(key, std::move(a));
+  }
+  toml::table* table_;
+};
+
+template <class S>
+void ReadSection(const toml::table& root, const char* name, const std::string& file, S* out) {
+  const toml::node* node = root.get(name);
+  if (node != nullptr && !node->is_table())
+    throw ConfigError(file, name, "expected a table ([" + std::string(name) + "])");
+  Reader reader(node ? node->as_table() : nullptr, name, file);
+  VisitFields(*out, reader);
+  reader.RejectUnknownKeys();
+}
+
+toml::table ToTable(Config& c) {
+  toml::table root;
+  auto section = [&](const char* name, auto& s) {
+    toml::table t;
+    Writer w(&t);
+    VisitFields(s, w);
+    root.insert_or_assign(name, std::move(t));
+  };
+  section("run", c.run);
+  section("fluid", c.fluid);
+  section("contact", c.contact);
+  section("gravity", c.gravity);
+  section("solver", c.solver);
+  toml::array rods;
+  for (RodConfig& r : c.rods) {
+    toml::table t;
+    Writer w(&t);
+    VisitFields(r, w);
+    rods.push_back(std::move(t));
+  }
+  root.insert_or_assign("rods", std::move(rods));
+  return root;
+}
+
+// ---- --set overrides. -----------------------------------------------------------------------
+
+std::vector<std::string> Split(const std::string& s, char sep) {
+  std::vector<std::string> parts;
+  std::stringstream in(s);
+  for (std::string part; std::getline(in, part, sep);) parts.push_back(part);
+  return parts;
+}
+
+void SetKey(toml::table* table, const std::vector<std::string>& path, std::size_t i,
+            const toml::node_view<toml::node>& value, const std::string& file,
+            const std::string& full) {
+  if (i + 1 == path.size()) {
+    table->insert_or_assign(path[i], value);
+    return;
+  }
+  toml::node* child = table->get(path[i]);
+  if (child == nullptr) {
+    table->insert_or_assign(path[i], toml::table{});
+    child = table->get(path[i]);
+  }
+  if (!child->is_table()) throw ConfigError(file, full, "--set path goes through a non-table");
+  SetKey(child->as_table(), path, i + 1, value, file, full);
+}
+
+void ApplyOverride(toml::table* root, const std::string& assignment, const std::string& file) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw ConfigError(file, assignment, "--set expects KEY=VALUE");
+  const std::string key = assignment.substr(0, eq);
+  const std::string text = assignment.substr(eq + 1);
+  toml::table parsed;
+  try {
+    parsed = toml::parse("v = " + text);
+  } catch (const toml::parse_error&) {
+    parsed = toml::table{{"v", text}};  // a bare word is a string: fluid.model=lsbt
+  }
+  const toml::node_view<toml::node> value = parsed["v"];
+  std::vector<std::string> path = Split(key, '.');
+  if (path.front() != "rods") {
+    SetKey(root, path, 0, value, file, key);
+    return;
+  }
+  toml::array* rods = root->get_as<toml::array>("rods");
+  if (rods == nullptr || path.size() < 2) throw ConfigError(file, key, "no [[rods]] to set");
+  const bool indexed = !path[1].empty() && path[1].find_first_not_of("0123456789") == std::string::npos;
+  if (indexed) {
+    const std::size_t k = std::stoul(path[1]);
+    if (k < 1 || k > rods->size())
+      throw ConfigError(file, key, fmt::format("rod {} does not exist (there are {})", k, rods->size()));
+    path.erase(path.begin(), path.begin() + 2);
+    if (path.empty()) throw ConfigError(file, key, "--set needs a key after the rod number");
+    SetKey(rods->get(k - 1)->as_table(), path, 0, value, file, key);
+    return;
+  }
+  path.erase(path.begin());
+  for (auto& rod : *rods) SetKey(rod.as_table(), path, 0, value, file, key);
+}
+
+}  // namespace
+
+void ValidateConfig(Config* config);  // config_validate.cc
+
+Config ParseConfig(const std::string& toml_text, const std::string& file,
+                   const std::vector<std::string>& overrides) {
+  toml::table root;
+  try {
+    root = toml::parse(toml_text, file);
+  } catch (const toml::parse_error& e) {
+    throw ConfigError(file, fmt::format("line {}", e.source().begin.line),
+                      std::string(e.description()));
+  }
+  for (const std::string& o : overrides) ApplyOverride(&root, o, file);
+
+  Config config;
+  config.file = file;
+  static const std::set<std::string> kSections = {"run",    "fluid", "contact",
+                                                  "gravity", "solver", "rods"};
+  for (const auto& [key, node] : root)
+    if (kSections.count(std::string(key.str())) == 0)
+      throw ConfigError(file, std::string(key.str()),
+                        "unknown section (known: run, fluid, contact, gravity, solver, rods)");
+  ReadSection(root, "run", file, &config.run);
+  ReadSection(root, "fluid", file, &config.fluid);
+  ReadSection(root, "contact", file, &config.contact);
+  ReadSection(root, "gravity", file, &config.gravity);
+  ReadSection(root, "solver", file, &config.solver);
+  const toml::node* rods = root.get("rods");
+  if (rods == nullptr) throw ConfigError(file, "rods", "missing: at least one [[rods]] is required");
+  if (!rods->is_array_of_tables()) throw ConfigError(file, "rods", "expected [[rods]] tables");
+  for (std::size_t i = 0; i < rods->as_array()->size(); ++i) {
+    RodConfig rod;
+    Reader reader(rods->as_array()->get(i)->as_table(), fmt::format("rods.{}", i + 1), file);
+    VisitFields(rod, reader);
+    reader.RejectUnknownKeys();
+    config.rods.push_back(std::move(rod));
+  }
+  ValidateConfig(&config);
+  return config;
+}
+
+Config LoadConfig(const std::string& path, const std::vector<std::string>& overrides) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError(path, "", "cannot open the file");
+  std::stringstream text;
+  text << in.rdbuf();
+  return ParseConfig(text.str(), path, overrides);
+}
+
+std::string ConfigToToml(const Config& config) {
+  Config copy = config;
+  std::stringstream out;
+  out << ToTable(copy);
+  return out.str();
+}
+
+std::string ConfigToJson(const Config& config) {
+  Config copy = config;
+  std::stringstream out;
+  out << toml::json_formatter{ToTable(copy)};
+  return out.str();
+}
+
+}  // namespace stokesrods

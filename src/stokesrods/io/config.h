@@ -1,0 +1,110 @@
+// The configuration file (SPEC "Configuration"): plain structs with defaults, read strictly.
+//
+// Each struct lists its fields once, in VisitFields; that one list drives the TOML reader (which
+// rejects unknown keys, wrong types and missing required keys), the echo of the resolved
+// configuration (show-config, summary.json) and the Python attributes.
+#pragma once
+
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "stokesrods/common/types.h"
+
+namespace stokesrods {
+
+/// Bad input: names the file, the key (dotted path) and what is wrong. Exit code 2.
+class ConfigError : public std::runtime_error {
+ public:
+  ConfigError(const std::string& file, const std::string& key, const std::string& problem);
+  const std::string& file() const { return file_; }
+  const std::string& key() const { return key_; }
+
+ private:
+  std::string file_, key_;
+};
+
+struct RunConfig {
+  std::string name = "stokesrods";
+  std::string output;                     ///< default: out/<name>
+  std::string mode = "dynamic";           ///< "dynamic" | "static"
+  std::optional<double> duration;         ///< [s]
+  std::optional<double> t_bar_end;        ///< normalized end time (paper eq. 24b)
+  double time_step = 1e-3;                ///< [s]
+  std::optional<double> output_interval;  ///< [s], default: 1/100 of the run
+  bool frames = true;
+  std::optional<double> checkpoint_interval;  ///< [s], default: 1/10 of the run
+};
+
+struct FluidConfig {
+  std::string model = "rss";       ///< "rss" | "lsbt" | "rft" | "none"
+  double viscosity = 1.0;          ///< μ [Pa·s]
+  double regularization = 1.02;    ///< ε / r0
+  std::string coupling = "implicit";  ///< "implicit" | "explicit"
+};
+
+struct ContactConfig {
+  bool enabled = true;
+  double tolerance = 1e-3;  ///< resolved when every distance ≥ (r_a + r_b)(1 − tolerance)
+  int max_rounds = 50;      ///< solve–detect–re-solve rounds per step before a failure
+};
+
+struct GravityConfig {
+  Vec3 acceleration = Vec3::Zero();  ///< [m/s²]
+};
+
+struct SolverConfig {
+  double newton_tolerance = 1e-8;   ///< residual force / force scale
+  int newton_max_iterations = 30;
+  double damping = 0.0;             ///< isotropic viscous damping per unit length [Pa·s]
+};
+
+struct PointLoadConfig {
+  int node = 0;
+  Vec3 force = Vec3::Zero();  ///< [N]
+};
+
+struct RodConfig {
+  std::string shape = "helix";  ///< "helix" | "straight" | "points"
+  double radius = 1e-3;         ///< r0 [m]
+  double young_modulus = 10e6;  ///< E [Pa]
+  double poisson_ratio = 0.5;   ///< ν
+  double density = 1000.0;      ///< ρ [kg/m³]
+  int nodes = 65;               ///< N (points: taken from `points`)
+  double axis_length = 0.2;     ///< l0 [m]
+  double pitch = 0.05;          ///< λ [m], helix
+  double helix_radius = 0.01;   ///< R [m], helix
+  std::string handedness = "right";
+  Vec3 base = Vec3::Zero();     ///< node 0 [m]
+  int clamped_nodes = 2;
+  std::optional<double> omega;      ///< [rad/s] about +ẑ
+  std::optional<double> omega_bar;  ///< ω μ l0⁴ / EI
+  std::vector<Vec3> points;         ///< shape = "points"
+  std::vector<PointLoadConfig> loads;
+};
+
+struct Config {
+  std::string file;  ///< where it was read from (for messages)
+  RunConfig run;
+  FluidConfig fluid;
+  ContactConfig contact;
+  GravityConfig gravity;
+  SolverConfig solver;
+  std::vector<RodConfig> rods;
+};
+
+/// Reads and validates a configuration file; `overrides` are "dotted.key=value" strings applied
+/// before validation (SPEC --set: rods.KEY sets it on every rod, rods.K.KEY on rod K, from 1).
+/// Throws ConfigError.
+Config LoadConfig(const std::string& path, const std::vector<std::string>& overrides = {});
+
+/// The same from TOML text (tests, Python dicts); `file` names it in messages.
+Config ParseConfig(const std::string& toml_text, const std::string& file,
+                   const std::vector<std::string>& overrides = {});
+
+/// The resolved configuration (every default filled in) as TOML text / as JSON text.
+std::string ConfigToToml(const Config& config);
+std::string ConfigToJson(const Config& config);
+
+}  // namespace stokesrods

@@ -1,0 +1,60 @@
+// Output files (SPEC "Outputs"): timeseries.csv, ParaView frames, checkpoints. Every writer flushes
+// what it has written before returning, so an interrupted run loses nothing.
+#pragma once
+
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "stokesrods/sim/model.h"
+#include "stokesrods/sim/state.h"
+
+namespace stokesrods {
+
+/// An input/output failure (exit code 4), naming the file.
+class IoError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// timeseries.csv: a header, then one flushed row per call.
+class CsvWriter {
+ public:
+  CsvWriter(const std::string& path, const std::vector<std::string>& columns, bool append = false);
+  ~CsvWriter();
+  CsvWriter(const CsvWriter&) = delete;
+  CsvWriter& operator=(const CsvWriter&) = delete;
+  void WriteRow(const std::vector<double>& row);
+
+ private:
+  std::string path_;
+  std::FILE* file_ = nullptr;
+};
+
+/// Per-node vectors written as point data of the frames (3M each, nodes of all rods in order).
+struct FramePointData {
+  std::string name;
+  const VecX* values = nullptr;
+};
+
+/// frames/rods_NNNNN.vtp (one polyline per rod) and the rods.pvd index, rewritten after every
+/// frame so ParaView can open a run while it goes.
+class FrameWriter {
+ public:
+  explicit FrameWriter(const std::string& output_dir);
+  void Write(const Model& model, const State& state, const std::vector<FramePointData>& data);
+
+ private:
+  std::string dir_;
+  std::vector<std::pair<double, std::string>> frames_;
+};
+
+/// Writes text to `path` through a temporary file and a rename (never a half-written file).
+void WriteFileAtomically(const std::string& path, const std::string& text);
+
+/// Checkpoint: the whole State, binary, written atomically.
+void SaveCheckpoint(const std::string& path, const State& state);
+State LoadCheckpoint(const std::string& path, const Model& model);
+
+}  // namespace stokesrods

@@ -1,0 +1,78 @@
+// The time step (paper section 2.4, Algorithm 1) and the static solve.
+//
+// One step of implicit Euler (eq. 22) solved by Newton's method (Jacobian eq. 23 plus the
+// Jacobians of the implicit external forces):
+//     r(q) = M (q − q_k − h v_k) / h² − F_int(q) − F_ext(q) − F^h(q) − F^c = 0,
+// q_{k+1} = q, v_{k+1} = (q_{k+1} − q_k)/h. Step never prints, writes files or exits: failures
+// come back as a report, and the state is left as it was before the step.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "stokesrods/sim/contact_forces.h"
+#include "stokesrods/sim/forces.h"
+#include "stokesrods/sim/hydro_coupling.h"
+#include "stokesrods/sim/model.h"
+#include "stokesrods/sim/state.h"
+#include "stokesrods/solver/banded_matrix.h"
+
+namespace stokesrods {
+
+struct NewtonReport {
+  bool converged = false;
+  int iterations = 0;
+  double residual = 0.0;   ///< weighted ∞-norm of r at the last iterate [N]
+  double tolerance = 0.0;  ///< what it had to reach [N]
+};
+
+struct StepReport {
+  bool ok = false;
+  std::string message;       ///< why it failed (empty on success)
+  int newton_iterations = 0; ///< summed over contact rounds
+  int contact_rounds = 0;
+  int contact_pairs = 0;     ///< most pairs that received contact forces in one round
+  ContactSummary contact;    ///< at the end of the step
+};
+
+/// Scratch reused from step to step (MuJoCo's mjData scratch): nothing in the loop allocates
+/// once the sizes are set.
+struct Workspace {
+  explicit Workspace(const Model& model);
+
+  std::vector<std::unique_ptr<ExternalForce>> local_forces;
+  HydroCoupling hydro;
+  bool nonlocal_fluid = false;   ///< RSS or LSBT
+  VecX q;                        ///< the Newton iterate q(t_{k+1})
+  VecX q_try;                    ///< line-search trial
+  std::vector<RodFrames> frames; ///< frames transported to q
+  std::vector<RodFrames> frames_try;
+  VecX force;                    ///< F_int + F_ext + F^h + F^c at q (after a converged solve)
+  VecX residual, residual_try, delta;
+  VecX contact_force;            ///< F^c, constant during a Newton solve
+  std::vector<BandedMatrix> jacobian;  ///< per rod
+  double load_factor = 1.0;      ///< static load continuation
+};
+
+/// The drive of the boundary conditions: the target values of the fixed DOFs at t_k + h
+/// (θ0 ← θ0 + h ω' for driven rods, everything else held).
+void DriveBoundaryConditions(const Model& model, double h, VecX* q);
+
+/// One implicit Euler step of size h from `state` (Algorithm 1 with the contact rounds).
+StepReport Step(const Model& model, double h, State* state, Workspace* ws);
+
+/// Static equilibrium F_int + F_ext = 0 under the loads and boundary conditions, by Newton with
+/// line search and load continuation. Velocity-dependent forces and inertia are absent.
+StepReport SolveStatic(const Model& model, State* state, Workspace* ws);
+
+/// Generalized force on the fixed DOFs summed per rod (paper eq. 25): the sum of elastic and
+/// external forces on the clamped nodes (force) and their moment about ẑ through node 0,
+/// including the twist moment on θ0 (torque_z). Uses ws.force of the last converged solve.
+struct ClampLoad {
+  Vec3 force = Vec3::Zero();
+  double torque_z = 0.0;
+};
+ClampLoad CalcClampLoad(const Model& model, const State& state, const Workspace& ws, int rod);
+
+}  // namespace stokesrods

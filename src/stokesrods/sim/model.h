@@ -1,0 +1,93 @@
+// The constant description of a simulation (MuJoCo's mjModel): rods, materials, rest shapes,
+// boundary conditions, loads and the force models. Built once from the configuration (see
+// io/build_model.h); never changed by a step.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "stokesrods/common/types.h"
+#include "stokesrods/fluid/hydrodynamics.h"
+
+namespace stokesrods {
+
+/// DOF layout of one rod (paper section 2.1): q = [x0, θ0, x1, θ1, …, θ_{N−2}, x_{N−1}], 4N − 1.
+inline int NodeDof(int node) { return 4 * node; }
+inline int TwistDof(int edge) { return 4 * edge + 3; }
+inline int RodDofCount(int nodes) { return 4 * nodes - 1; }
+
+struct PointLoad {
+  int node = 0;
+  Vec3 force = Vec3::Zero();  ///< [N]
+};
+
+struct RodModel {
+  // Material and cross section.
+  double radius = 0.0;              ///< r0 [m]
+  double density = 0.0;             ///< ρ [kg/m³]
+  double axial_stiffness = 0.0;     ///< EA [N]
+  double bending_stiffness = 0.0;   ///< EI = E π r0⁴/4 [N·m²]
+  double twisting_stiffness = 0.0;  ///< GJ, G = E/(2(1+ν)), J = π r0⁴/2 [N·m²]
+
+  // Rest shape (stress-free), from which the rest strains are measured.
+  Matrix3X rest_positions;      ///< 3 × N [m]
+  VecX rest_edge_length;        ///< |ē^i|, N − 1 [m]
+  VecX rest_voronoi_length;     ///< Δl_i = (|ē^{i−1}| + |ē^i|)/2, ends: half an edge, N [m]
+  std::vector<Vec2> rest_curvature;  ///< (κ̄⁽¹⁾, κ̄⁽²⁾) per node (interior nodes used), N
+  VecX rest_twist;              ///< τ̄ per node (interior nodes used), N [rad]
+  VecX mass;                    ///< lumped mass per DOF, 4N − 1: ρAΔl_i on x_i, ρJ|ē^j| on θ^j
+
+  // Boundary conditions.
+  int clamped_nodes = 0;        ///< 0, 1 or 2 leading nodes held fixed (2 also holds θ0)
+  double twist_rate = 0.0;      ///< dθ0/dt [rad/s] imposed when clamped_nodes == 2
+  double omega = 0.0;           ///< rotation rate about +ẑ as configured [rad/s]
+  std::vector<int> fixed_dofs;  ///< local DOFs held at their current value, sorted
+  std::vector<PointLoad> loads;
+
+  // Resistive force theory coefficients (c_∥, c_⊥) per unit length [Pa·s], fluid.model = rft.
+  Vec2 rft_coefficients = Vec2::Zero();
+
+  // Descriptive geometry (for observables).
+  double axis_length = 0.0;     ///< l0 [m]
+  double helix_radius = 0.0;    ///< R [m] (0 when not a helix)
+
+  // Place in the global vectors.
+  int dof_offset = 0;           ///< first index of this rod in the global q
+  int node_offset = 0;          ///< first node of this rod among all nodes (fluid, contact)
+
+  int num_nodes() const { return static_cast<int>(rest_positions.cols()); }
+  int num_dofs() const { return RodDofCount(num_nodes()); }
+};
+
+enum class FluidCoupling { kImplicit, kExplicit };
+
+struct NewtonOptions {
+  double tolerance = 1e-8;     ///< on the residual force, relative to the force scale [–]
+  int max_iterations = 30;
+  int max_contact_rounds = 50; ///< Algorithm 1: solve–detect–re-solve rounds per step
+  double contact_tolerance = 1e-3;  ///< a pair is resolved when distance ≥ 2r0 (1 − this)
+};
+
+struct Model {
+  std::vector<RodModel> rods;
+  FluidParams fluid;                 ///< fluid.model == kNone: no hydrodynamics
+  FluidCoupling coupling = FluidCoupling::kImplicit;
+  bool contact = false;
+  Vec3 gravity = Vec3::Zero();       ///< [m/s²]
+  double damping = 0.0;              ///< local viscous damping per unit length [Pa·s] (validation)
+  NewtonOptions newton;
+  double force_scale = 0.0;          ///< characteristic force max EI/L² over rods [N]
+
+  int num_dofs = 0;
+  int num_nodes = 0;
+};
+
+/// Fills dof_offset/node_offset, num_dofs/num_nodes and force_scale from the rods.
+void FinalizeLayout(Model* model);
+
+/// Fills the rest quantities (lengths, Voronoi lengths, masses, rest curvatures and twist from
+/// space-parallel frames of the rest shape) and the DOFs fixed by clamped_nodes. The rod's
+/// radius, density, stiffnesses, rest_positions and clamped_nodes must be set.
+void FinalizeRod(RodModel* rod);
+
+}  // namespace stokesrods

@@ -1,0 +1,67 @@
+// A square banded matrix with its LU factorization (LAPACK dgbtrf/dgbtrs, partial pivoting).
+//
+// The Jacobian of one discrete rod couples only DOFs within one bending stencil
+// (x_{i−1}, θ^{i−1}, x_i, θ^i, x_{i+1}: 11 consecutive entries of q), so its half bandwidth is 10
+// and a solve costs O(N) for N nodes. Partial pivoting keeps the solve correct when the
+// matrix is indefinite (compressed or buckling rods in a static solve).
+#pragma once
+
+#include <vector>
+
+#include "stokesrods/common/types.h"
+
+namespace stokesrods {
+
+class BandedMatrix {
+ public:
+  BandedMatrix() = default;
+  BandedMatrix(int size, int half_bandwidth) { Resize(size, half_bandwidth); }
+
+  void Resize(int size, int half_bandwidth);
+  void SetZero();
+
+  int size() const { return n_; }
+  int half_bandwidth() const { return kd_; }
+
+  /// Entry (i, j); precondition |i − j| ≤ half_bandwidth.
+  double& operator()(int i, int j) { return ab_[Index(i, j)]; }
+  double operator()(int i, int j) const { return ab_[Index(i, j)]; }
+
+  /// Adds the dense block `block` with its top-left corner at (first, first).
+  template <typename Derived>
+  void AddBlock(int first, const Eigen::MatrixBase<Derived>& block) {
+    for (int c = 0; c < block.cols(); ++c)
+      for (int r = 0; r < block.rows(); ++r) (*this)(first + r, first + c) += block(r, c);
+  }
+
+  /// Replaces row and column k by those of the identity (a fixed DOF).
+  void FixDof(int k);
+
+  /// y += A x.
+  void MultiplyAdd(const VecX& x, VecX* y) const;
+
+  /// Dense copy (for tests and small debugging).
+  MatX ToDense() const;
+
+  /// LU-factorizes in place; returns false if the matrix is singular. After this the
+  /// entries are the factors: only Solve may be used until the next SetZero.
+  bool Factorize();
+  /// Solves A x = b in place for one or more right-hand sides (columns of b).
+  void Solve(double* b, int num_rhs) const;
+  void Solve(VecX* b) const { Solve(b->data(), 1); }
+  void Solve(MatX* b) const { Solve(b->data(), static_cast<int>(b->cols())); }
+
+ private:
+  // LAPACK general band storage with kl = ku = kd and kd extra rows for the fill of pivoting:
+  // A(i, j) is stored at ab_[(2kd + i − j) + j · ldab], ldab = 3kd + 1.
+  int Index(int i, int j) const { return (2 * kd_ + i - j) + j * ldab_; }
+
+  int n_ = 0;
+  int kd_ = 0;
+  int ldab_ = 1;
+  std::vector<double> ab_;
+  std::vector<int> pivots_;
+  bool factorized_ = false;
+};
+
+}  // namespace stokesrods
