@@ -8,6 +8,7 @@
 // transport of the frame of edge i−1.
 #pragma once
 
+#include <Eigen/Geometry>  // cross products (types.h brings only Eigen/Core)
 #include <vector>
 
 #include "stokesrods/common/types.h"
