@@ -55,13 +55,11 @@ void HydroCoupling::AddTo(const Model& model, const StepContext& ctx, const VecX
           nodal_force_.segment<3>(3 * (rod.node_offset + i));
 }
 
-bool HydroCoupling::SolveNewtonSystem(const Model& model, double h,
-                                      std::vector<BandedMatrix>* jacobian, VecX* rhs) {
+bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
+                                          std::vector<BandedMatrix>* jacobian) {
   SR_ASSERT(!explicit_, "the Woodbury solve is for the implicit coupling");
-  const int m3 = 3 * model.num_nodes;
   capacitance_ = h * mobility_;
   x_blocks_.resize(model.rods.size());
-  VecX s_y = VecX::Zero(m3);
   for (std::size_t r = 0; r < model.rods.size(); ++r) {
     const RodModel& rod = model.rods[r];
     const int n = rod.num_nodes();
@@ -75,22 +73,31 @@ bool HydroCoupling::SolveNewtonSystem(const Model& model, double h,
         if (!std::binary_search(rod.fixed_dofs.begin(), rod.fixed_dofs.end(), NodeDof(i) + c))
           x(NodeDof(i) + c, 3 * i + c) = 1.0;
     b.Solve(&x);
-    // y_k = B_k⁻¹ r_k, in place; then S y and the block S_k X_k of the capacitance.
-    b.Solve(rhs->data() + rod.dof_offset, 1);
+    // The block S_k X_k of the capacitance h 𝕄 + S X (rows of fixed DOFs of X are zero).
     const int first = 3 * rod.node_offset;
-    for (int i = 0; i < n; ++i) {
-      s_y.segment<3>(first + 3 * i) = rhs->segment<3>(rod.dof_offset + NodeDof(i));
+    for (int i = 0; i < n; ++i)
       capacitance_.block(first + 3 * i, first, 3, 3 * n) += x.middleRows<3>(NodeDof(i));
-    }
   }
   capacitance_lu_.compute(capacitance_);
-  const VecX z = capacitance_lu_.solve(s_y);
+  return true;
+}
+
+void HydroCoupling::SolveNewtonSystem(const Model& model, const std::vector<BandedMatrix>& jacobian,
+                                      VecX* rhs) {
+  // J⁻¹ r = y − X (h 𝕄 + S X)⁻¹ S y,  y = B⁻¹ r.
+  velocity_.resize(3 * model.num_nodes);
+  for (std::size_t r = 0; r < model.rods.size(); ++r) {
+    const RodModel& rod = model.rods[r];
+    jacobian[r].Solve(rhs->data() + rod.dof_offset, 1);
+    for (int i = 0; i < rod.num_nodes(); ++i)
+      velocity_.segment<3>(3 * (rod.node_offset + i)) = rhs->segment<3>(rod.dof_offset + NodeDof(i));
+  }
+  const VecX z = capacitance_lu_.solve(velocity_);
   for (std::size_t r = 0; r < model.rods.size(); ++r) {
     const RodModel& rod = model.rods[r];
     rhs->segment(rod.dof_offset, rod.num_dofs()) -=
         x_blocks_[r] * z.segment(3 * rod.node_offset, 3 * rod.num_nodes());
   }
-  return true;
 }
 
 }  // namespace stokesrods

@@ -29,9 +29,11 @@ class HydroCoupling {
   /// Adds F^h at the trial DOFs q into the global `force`.
   void AddTo(const Model& model, const StepContext& ctx, const VecX& q, VecX* force);
 
-  /// Solves J δ = rhs in place (implicit coupling), `jacobian` the unfactorized per-rod banded
-  /// parts B (fixed DOFs already identity rows). Returns false if a factorization failed.
-  bool SolveNewtonSystem(const Model& model, double h, std::vector<BandedMatrix>* jacobian,
+  /// Factorizes J = B + Sᵀ 𝕄⁻¹ S / h (implicit coupling), `jacobian` the unfactorized per-rod
+  /// banded parts B (fixed DOFs already identity rows; factorized in place). False if singular.
+  bool FactorizeNewtonSystem(const Model& model, double h, std::vector<BandedMatrix>* jacobian);
+  /// Solves J δ = rhs in place with the factors of the last FactorizeNewtonSystem.
+  void SolveNewtonSystem(const Model& model, const std::vector<BandedMatrix>& jacobian,
                          VecX* rhs);
 
   /// Nodal hydrodynamic forces on the rods (3M) at the last AddTo [N].

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -13,7 +14,7 @@ Workspace::Workspace(const Model& model) : local_forces(MakeLocalForces(model)) 
   nonlocal_fluid =
       model.fluid.model == FluidModel::kRss || model.fluid.model == FluidModel::kLsbt;
   const int n = model.num_dofs;
-  q = q_try = force = residual = residual_try = delta = contact_force = VecX::Zero(n);
+  q = q_try = force = residual = residual_try = delta = simplified = contact_force = VecX::Zero(n);
   for (const RodModel& rod : model.rods) jacobian.emplace_back(rod.num_dofs(), 10);
 }
 
@@ -36,8 +37,20 @@ double ResidualNorm(const Model& model, const VecX& r) {
   return norm;
 }
 
-// r(q) and, when `with_jacobian`, the per-rod banded Jacobians ∂r/∂q in ws->jacobian.
-// h = 0 is the static problem (no inertia, no velocity-dependent forces).
+// The residual that round-off alone leaves: a position known to ε|x| changes a stretching force
+// by EA ε |x| / |ē|; a few ulps of that summed over a node's stencils [N].
+double RoundOffFloor(const Model& model, const VecX& q) {
+  double floor = 0.0;
+  for (const RodModel& rod : model.rods) {
+    const double extent = q.segment(rod.dof_offset, rod.num_dofs()).cwiseAbs().maxCoeff();
+    floor = std::max(floor, 16.0 * std::numeric_limits<double>::epsilon() * rod.axial_stiffness *
+                                extent / rod.rest_edge_length.minCoeff());
+  }
+  return floor;
+}
+
+}  // namespace
+
 void Evaluate(const Model& model, const State& start, double h, const VecX& q, bool with_jacobian,
               Workspace* ws, std::vector<RodFrames>* frames, VecX* residual) {
   TransportFrames(model, q, start.rods, frames);
@@ -68,50 +81,84 @@ void Evaluate(const Model& model, const State& start, double h, const VecX& q, b
   }
 }
 
-// δ = −J⁻¹ r.
-bool SolveLinear(const Model& model, double h, const VecX& residual, Workspace* ws) {
-  ws->delta = -residual;
-  if (h > 0.0 && ws->nonlocal_fluid && model.coupling == FluidCoupling::kImplicit)
-    return ws->hydro.SolveNewtonSystem(model, h, &ws->jacobian, &ws->delta);
-  for (std::size_t r = 0; r < model.rods.size(); ++r) {
-    if (!ws->jacobian[r].Factorize()) return false;
-    ws->jacobian[r].Solve(ws->delta.data() + model.rods[r].dof_offset, 1);
-  }
+namespace {
+
+bool UsesWoodbury(const Model& model, double h, const Workspace& ws) {
+  return h > 0.0 && ws.nonlocal_fluid && model.coupling == FluidCoupling::kImplicit;
+}
+
+// Factorizes the Newton matrix assembled in ws->jacobian (in place).
+bool FactorizeJacobian(const Model& model, double h, Workspace* ws) {
+  if (UsesWoodbury(model, h, *ws)) return ws->hydro.FactorizeNewtonSystem(model, h, &ws->jacobian);
+  for (BandedMatrix& b : ws->jacobian)
+    if (!b.Factorize()) return false;
   return true;
 }
 
-// Newton's method with a backtracking line search on |r|, from the iterate in ws->q.
+// out = −J⁻¹ r with the current factors.
+void NewtonCorrection(const Model& model, double h, const VecX& residual, Workspace* ws,
+                      VecX* out) {
+  *out = -residual;
+  if (UsesWoodbury(model, h, *ws)) {
+    ws->hydro.SolveNewtonSystem(model, ws->jacobian, out);
+    return;
+  }
+  for (std::size_t r = 0; r < model.rods.size(); ++r)
+    ws->jacobian[r].Solve(out->data() + model.rods[r].dof_offset, 1);
+}
+
+// Size of a correction in metres: positions as they are, twist angles times their edge length.
+double CorrectionNorm(const Model& model, const VecX& delta) {
+  double sum = 0.0;
+  for (const RodModel& rod : model.rods)
+    for (int k = 0; k < rod.num_dofs(); ++k) {
+      const double w = (k % 4 == 3) ? rod.rest_edge_length(k / 4) : 1.0;
+      sum += std::pow(w * delta(rod.dof_offset + k), 2);
+    }
+  return std::sqrt(sum);
+}
+
+// Newton's method from the iterate in ws->q, globalized by Deuflhard's natural monotonicity test:
+// a step α δ is accepted when the simplified correction −J⁻¹ r(q + α δ), with the same factors,
+// is smaller than (1 − α/4) |δ|. Unlike a test on |r|, this is affine invariant, so the stiff
+// stretching modes (EA ≫ EI/L²) do not stall it. Converged when the residual is below the
+// tolerance, or when the next correction is below 1e-10 of the rod length (conditioning allows
+// no better).
 NewtonReport SolveNewton(const Model& model, const State& start, double h, Workspace* ws) {
   NewtonReport report;
+  const double step_tolerance = 1e-10 * model.length_scale;
   Evaluate(model, start, h, ws->q, true, ws, &ws->frames, &ws->residual);
   double norm = ResidualNorm(model, ws->residual);
-  for (report.iterations = 0; report.iterations < model.newton.max_iterations;
-       ++report.iterations) {
-    // The force scale: the characteristic bending force or the applied forces, if larger.
+  bool small_correction = false;
+  for (report.iterations = 0;; ++report.iterations) {
+    // The force scale: the characteristic bending force or the applied forces, if larger; never
+    // below the round-off floor of the stretching forces.
     const double scale = std::max(model.force_scale, ResidualNorm(model, ws->force));
-    report.tolerance = model.newton.tolerance * scale;
+    report.tolerance = std::max(model.newton.tolerance * scale, RoundOffFloor(model, ws->q));
     report.residual = norm;
-    if (norm <= report.tolerance) {
+    if (norm <= report.tolerance || small_correction) {
       report.converged = true;
       return report;
     }
+    if (report.iterations == model.newton.max_iterations) return report;
     if (report.iterations > 0) Evaluate(model, start, h, ws->q, true, ws, &ws->frames, &ws->residual);
-    if (!SolveLinear(model, h, ws->residual, ws)) return report;
-    const double norm2 = ws->residual.squaredNorm();
-    double alpha = 1.0;
-    for (int halving = 0; halving < 8; ++halving, alpha *= 0.5) {
+    if (!FactorizeJacobian(model, h, ws)) return report;
+    NewtonCorrection(model, h, ws->residual, ws, &ws->delta);
+    const double delta_norm = CorrectionNorm(model, ws->delta);
+    double alpha = 1.0, simplified_norm = 0.0;
+    for (int halving = 0;; ++halving, alpha *= 0.5) {
       ws->q_try = ws->q + alpha * ws->delta;
       Evaluate(model, start, h, ws->q_try, false, ws, &ws->frames_try, &ws->residual_try);
-      if (ws->residual_try.squaredNorm() <= (1.0 - 1e-4 * alpha) * norm2) break;
+      NewtonCorrection(model, h, ws->residual_try, ws, &ws->simplified);
+      simplified_norm = CorrectionNorm(model, ws->simplified);
+      if (simplified_norm <= (1.0 - 0.25 * alpha) * delta_norm || halving == 10) break;
     }
     std::swap(ws->q, ws->q_try);
     std::swap(ws->frames, ws->frames_try);
     std::swap(ws->residual, ws->residual_try);
     norm = ResidualNorm(model, ws->residual);
+    small_correction = simplified_norm <= step_tolerance;
   }
-  report.residual = norm;
-  report.converged = norm <= report.tolerance;
-  return report;
 }
 
 }  // namespace

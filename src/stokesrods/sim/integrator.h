@@ -49,11 +49,18 @@ struct Workspace {
   std::vector<RodFrames> frames; ///< frames transported to q
   std::vector<RodFrames> frames_try;
   VecX force;                    ///< F_int + F_ext + F^h + F^c at q (after a converged solve)
-  VecX residual, residual_try, delta;
+  VecX residual, residual_try, delta, simplified;
   VecX contact_force;            ///< F^c, constant during a Newton solve
   std::vector<BandedMatrix> jacobian;  ///< per rod
   double load_factor = 1.0;      ///< static load continuation
 };
+
+/// The residual r(q) of the step from `start` (h = 0: the static problem, without inertia and
+/// velocity-dependent forces) with the frames transported to q into `frames`, and, when
+/// `with_jacobian`, the per-rod banded Jacobians ∂r/∂q in ws->jacobian (nonlocal implicit drag
+/// excluded: it enters through HydroCoupling::SolveNewtonSystem). Fixed DOFs: r = 0, identity rows.
+void Evaluate(const Model& model, const State& start, double h, const VecX& q, bool with_jacobian,
+              Workspace* ws, std::vector<RodFrames>* frames, VecX* residual);
 
 /// The drive of the boundary conditions: the target values of the fixed DOFs at t_k + h
 /// (θ0 ← θ0 + h ω' for driven rods, everything else held).

@@ -61,6 +61,7 @@ void FinalizeLayout(Model* model) {
     nodes += rod.num_nodes();
     const double length = rod.rest_edge_length.sum();
     force_scale = std::max(force_scale, rod.bending_stiffness / (length * length));
+    model->length_scale = std::max(model->length_scale, length);
   }
   model->num_dofs = dofs;
   model->num_nodes = nodes;

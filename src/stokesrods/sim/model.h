@@ -77,12 +77,13 @@ struct Model {
   double damping = 0.0;              ///< local viscous damping per unit length [Pa·s] (validation)
   NewtonOptions newton;
   double force_scale = 0.0;          ///< characteristic force max EI/L² over rods [N]
+  double length_scale = 0.0;         ///< longest rod arc length [m]
 
   int num_dofs = 0;
   int num_nodes = 0;
 };
 
-/// Fills dof_offset/node_offset, num_dofs/num_nodes and force_scale from the rods.
+/// Fills dof_offset/node_offset, num_dofs/num_nodes, force_scale and length_scale from the rods.
 void FinalizeLayout(Model* model);
 
 /// Fills the rest quantities (lengths, Voronoi lengths, masses, rest curvatures and twist from
