@@ -1,0 +1,106 @@
+// The command line as users and scripts see it: exit codes, messages, and the SPEC output files.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Outcome {
+  int code = -1;
+  std::string err;
+};
+
+Outcome RunCli(const std::string& args) {
+  const fs::path err = fs::temp_directory_path() / "stokesrods_cli_test.err";
+  const std::string cmd = std::string(STOKESRODS_BINARY) + " " + args + " > /dev/null 2> " +
+                          err.string() + " < /dev/null";
+  const int status = std::system(cmd.c_str());
+  std::ifstream in(err);
+  std::stringstream text;
+  text << in.rdbuf();
+  return {WEXITSTATUS(status), text.str()};
+}
+
+fs::path WriteConfig(const std::string& name, const std::string& text) {
+  const fs::path dir = fs::temp_directory_path() / "stokesrods_cli_test";
+  fs::create_directories(dir);
+  std::ofstream(dir / name) << text;
+  return dir / name;
+}
+
+std::string Read(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(Cli, VersionAndHelp) {
+  EXPECT_EQ(RunCli("--version").code, 0);
+  EXPECT_EQ(RunCli("--help").code, 0);
+  EXPECT_EQ(RunCli("run --help").code, 0);
+  EXPECT_EQ(RunCli("frobnicate").code, 2);
+}
+
+TEST(Cli, CantileverWritesTheSpecFiles) {
+  const fs::path out = fs::temp_directory_path() / "stokesrods_cli_cantilever";
+  fs::remove_all(out);
+  const Outcome o = RunCli(std::string("run ") + STOKESRODS_SOURCE_DIR + "/examples/cantilever.toml --output " + out.string());
+  ASSERT_EQ(o.code, 0) << o.err;
+  const std::string csv = Read(out / "timeseries.csv");
+  EXPECT_EQ(csv.rfind("time,t_bar,rod1_end_x,rod1_end_y,rod1_end_z,rod1_length,rod1_length_bar,"
+                      "rod1_force_x,rod1_force_y,rod1_force_z,rod1_torque_z,propulsive_force,"
+                      "propulsive_force_bar", 0), 0u) << csv;
+  const nlohmann::json summary = nlohmann::json::parse(Read(out / "summary.json"));
+  EXPECT_EQ(summary["status"], "completed");
+  for (const char* key : {"message", "config", "derived", "final", "max_penetration", "steps",
+                          "newton_iterations", "wall_seconds", "version"})
+    EXPECT_TRUE(summary.contains(key)) << key;
+  EXPECT_TRUE(summary["derived"].contains("EI"));
+  EXPECT_TRUE(summary["derived"].contains("time_scale"));
+  // The reaction at the clamp balances the tip load (paper eq. 25: elastic + external forces).
+  EXPECT_NEAR(summary["final"]["rod1_force_x"].get<double>(), 1e-5, 1e-12);
+  EXPECT_TRUE(fs::exists(out / "frames" / "rods_00000.vtp"));
+  EXPECT_TRUE(fs::exists(out / "rods.pvd"));
+}
+
+TEST(Cli, BadInputIsExitTwoWithFileKeyAndProblem) {
+  const fs::path cfg = WriteConfig("bad.toml", "[run]\nmode = \"static\"\n[[rods]]\nradius = -1.0\n");
+  const Outcome o = RunCli("run " + cfg.string());
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("bad.toml: rods.1.radius: must be a finite number > 0"), std::string::npos) << o.err;
+  EXPECT_EQ(RunCli("run /nonexistent/case.toml").code, 2);
+  EXPECT_EQ(RunCli("run " + cfg.string() + " --set rods.radius=0.001 --set nope").code, 2);
+}
+
+TEST(Cli, UnwritableOutputIsExitFour) {
+  const fs::path cfg = WriteConfig("static.toml",
+                                   "[run]\nmode = \"static\"\noutput = \"/proc/stokesrods/x\"\n"
+                                   "[fluid]\nmodel = \"none\"\n[[rods]]\nshape = \"straight\"\n");
+  EXPECT_EQ(RunCli("run " + cfg.string()).code, 4);
+}
+
+TEST(Cli, NumericalFailureIsExitThreeWithTheLastGoodStateSaved) {
+  const fs::path out = fs::temp_directory_path() / "stokesrods_cli_failure";
+  fs::remove_all(out);
+  // One Newton iteration cannot converge a step that starts far from equilibrium.
+  const fs::path cfg = WriteConfig(
+      "fail.toml", "[run]\nduration = 1.0\ntime_step = 0.5\n[fluid]\nmodel = \"none\"\n"
+                   "[solver]\nnewton_max_iterations = 1\n[[rods]]\nshape = \"straight\"\n"
+                   "loads = [{node = 64, force = [1.0, 0.0, 0.0]}]\n");
+  const Outcome o = RunCli("run " + cfg.string() + " --output " + out.string());
+  EXPECT_EQ(o.code, 3) << o.err;
+  EXPECT_NE(o.err.find("Newton did not converge at t = 0.5 s"), std::string::npos) << o.err;
+  const nlohmann::json summary = nlohmann::json::parse(Read(out / "summary.json"));
+  EXPECT_EQ(summary["status"], "failed");
+  EXPECT_TRUE(fs::exists(out / "checkpoint.bin"));
+}
+
+}  // namespace
