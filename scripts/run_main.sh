@@ -7,4 +7,4 @@ bash scripts/install_deps.sh
 cmake --preset release
 cmake --build --preset release --target stokesrods
 ./build/release/apps/stokesrods/stokesrods run examples/fig1_bundling.toml "$@"
-python3 python/plot_snapshots.py out/fig1 --times 0 25 50 75
+/usr/bin/python3 python/plot_snapshots.py out/fig1 --times 0 25 50 75
