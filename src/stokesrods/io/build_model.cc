@@ -51,6 +51,7 @@ Model BuildModel(const Config& config) {
   model.damping = config.solver.damping;
   model.newton.tolerance = config.solver.newton_tolerance;
   model.newton.max_iterations = config.solver.newton_max_iterations;
+  model.newton.jacobian_max_age = config.solver.jacobian_max_age;
   model.newton.max_contact_rounds = config.contact.max_rounds;
   model.newton.contact_tolerance = config.contact.tolerance;
 

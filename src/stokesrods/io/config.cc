@@ -50,6 +50,7 @@ template <class V>
 void VisitFields(SolverConfig& c, V& v) {
   v("newton_tolerance", c.newton_tolerance);
   v("newton_max_iterations", c.newton_max_iterations);
+  v("jacobian_max_age", c.jacobian_max_age);
   v("damping", c.damping);
 }
 template <class V>

@@ -112,6 +112,7 @@ void ValidateConfig(Config* config) {
   c.Finite("gravity.acceleration", config->gravity.acceleration);
   c.Positive("solver.newton_tolerance", config->solver.newton_tolerance);
   c.Range("solver.newton_max_iterations", config->solver.newton_max_iterations, 1, 10000);
+  c.Range("solver.jacobian_max_age", config->solver.jacobian_max_age, 0, 1000000);
   c.NonNegative("solver.damping", config->solver.damping);
 
   if (config->rods.empty()) throw ConfigError(c.file, "rods", "at least one [[rods]] is required");

@@ -123,11 +123,16 @@ double CorrectionNorm(const Model& model, const VecX& delta) {
 // is smaller than (1 − α/4) |δ|. Unlike a test on |r|, this is affine invariant, so the stiff
 // stretching modes (EA ≫ EI/L²) do not stall it. Converged when the residual is below the
 // tolerance, or when the next correction is below 1e-10 of the rod length (conditioning allows
-// no better).
+// no better). The factorized Newton matrix is kept across iterations and steps (modified Newton)
+// while it contracts well: rebuilt when it is older than jacobian_max_age steps, when h changed,
+// or when one iteration reduces the correction by less than a factor 4.
 NewtonReport SolveNewton(const Model& model, const State& start, double h, Workspace* ws) {
   NewtonReport report;
   const double step_tolerance = 1e-10 * model.length_scale;
-  Evaluate(model, start, h, ws->q, true, ws, &ws->frames, &ws->residual);
+  bool fresh = !ws->factors_valid || ws->factors_h != h ||
+               ws->factors_age >= model.newton.jacobian_max_age;
+  Evaluate(model, start, h, ws->q, fresh, ws, &ws->frames, &ws->residual);
+  bool have_jacobian = fresh;
   double norm = ResidualNorm(model, ws->residual);
   bool small_correction = false;
   for (report.iterations = 0;; ++report.iterations) {
@@ -141,8 +146,13 @@ NewtonReport SolveNewton(const Model& model, const State& start, double h, Works
       return report;
     }
     if (report.iterations == model.newton.max_iterations) return report;
-    if (report.iterations > 0) Evaluate(model, start, h, ws->q, true, ws, &ws->frames, &ws->residual);
-    if (!FactorizeJacobian(model, h, ws)) return report;
+    if (fresh) {
+      if (!have_jacobian) Evaluate(model, start, h, ws->q, true, ws, &ws->frames, &ws->residual);
+      ws->factors_valid = FactorizeJacobian(model, h, ws);
+      ws->factors_h = h;
+      ws->factors_age = 0;
+      if (!ws->factors_valid) return report;
+    }
     NewtonCorrection(model, h, ws->residual, ws, &ws->delta);
     const double delta_norm = CorrectionNorm(model, ws->delta);
     double alpha = 1.0, simplified_norm = 0.0;
@@ -158,6 +168,9 @@ NewtonReport SolveNewton(const Model& model, const State& start, double h, Works
     std::swap(ws->residual, ws->residual_try);
     norm = ResidualNorm(model, ws->residual);
     small_correction = simplified_norm <= step_tolerance;
+    // Poor contraction (or a damped step): rebuild the factors at the new iterate.
+    have_jacobian = false;
+    fresh = simplified_norm > 0.25 * delta_norm || alpha < 1.0;
   }
 }
 
@@ -205,6 +218,7 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
   ws->frames = state->rods;
   state->time += h;
   ++state->step;
+  ++ws->factors_age;
   report.ok = true;
   return report;
 }

@@ -53,6 +53,10 @@ struct Workspace {
   VecX contact_force;            ///< F^c, constant during a Newton solve
   std::vector<BandedMatrix> jacobian;  ///< per rod
   double load_factor = 1.0;      ///< static load continuation
+  // Reuse of the factorized Newton matrix across iterations and steps (modified Newton).
+  bool factors_valid = false;    ///< ws.jacobian (and the Woodbury factors) hold usable factors
+  double factors_h = -1.0;       ///< the step size they were built for (0: static)
+  int factors_age = 0;           ///< steps since they were built
 };
 
 /// The residual r(q) of the step from `start` (h = 0: the static problem, without inertia and
