@@ -68,8 +68,53 @@ double MinDistanceBetweenRods(const Model& model, const VecX& q) {
   return best;
 }
 
+namespace {
+
+// Change of the separation of `pair` along its normal under the nodal displacement dq.
+double SeparationChange(const Model& model, const ContactPair& pair, const VecX& dq) {
+  auto node = [&](const SegmentId& seg, int k) {
+    return Vec3(dq.segment<3>(model.rods[seg.rod].dof_offset + NodeDof(seg.index + k)));
+  };
+  const double s = pair.closest.s, t = pair.closest.t;
+  const Vec3 moved_a = (1.0 - s) * node(pair.segments.a, 0) + s * node(pair.segments.a, 1);
+  const Vec3 moved_b = (1.0 - t) * node(pair.segments.b, 0) + t * node(pair.segments.b, 1);
+  return pair.normal.dot(moved_b - moved_a);
+}
+
+// λ ≥ 0 with W λ = ε on the pairs that stay active (a pair with λ < 0 is pulled, not pushed:
+// dropped and the rest solved again).
+VecX SolveMultipliers(const MatX& w, const VecX& eps) {
+  const Eigen::Index p = eps.size();
+  std::vector<bool> active(p, true);
+  VecX lambda = VecX::Zero(p);
+  for (int pass = 0; pass < p + 1; ++pass) {
+    std::vector<Eigen::Index> idx;
+    for (Eigen::Index k = 0; k < p; ++k) if (active[k]) idx.push_back(k);
+    if (idx.empty()) break;
+    MatX ws(idx.size(), idx.size());
+    VecX rhs(idx.size());
+    for (std::size_t a = 0; a < idx.size(); ++a) {
+      rhs(a) = eps(idx[a]);
+      for (std::size_t b = 0; b < idx.size(); ++b) ws(a, b) = w(idx[a], idx[b]);
+    }
+    const VecX sub = ws.fullPivLu().solve(rhs);
+    lambda.setZero();
+    bool negative = false;
+    for (std::size_t a = 0; a < idx.size(); ++a) {
+      lambda(idx[a]) = sub(a);
+      if (!(sub(a) >= 0.0)) active[idx[a]] = false, negative = true;
+    }
+    if (!negative) return lambda;
+  }
+  // No consistent solution: fall back to each pair on its own.
+  for (Eigen::Index k = 0; k < p; ++k) lambda(k) = w(k, k) > 0.0 ? eps(k) / w(k, k) : 1.0;
+  return lambda;
+}
+
+}  // namespace
+
 ContactSummary AddContactForces(const Model& model, const VecX& q, double h,
-                                VecX* contact_force) {
+                                const LinearResponse& respond, VecX* contact_force) {
   const ContactInput in = MakeInput(model, q);
   const std::vector<ContactPair> pairs = DetectContacts(in.rods, in.radii, in.self_exclusion);
   const ContactSummary summary = Summarize(model, pairs);
@@ -86,13 +131,25 @@ ContactSummary AddContactForces(const Model& model, const VecX& q, double h,
     }
     inverse_masses.push_back(std::move(w));
   }
-  const std::vector<Matrix3X> dx = CalcContactDisplacements(pairs, inverse_masses);
-  for (std::size_t r = 0; r < model.rods.size(); ++r) {  // eq. 20: F = m Δx / h²
-    const RodModel& rod = model.rods[r];
-    for (int i = 0; i < rod.num_nodes(); ++i)
-      contact_force->segment<3>(rod.dof_offset + NodeDof(i)) +=
-          rod.mass(NodeDof(i)) * dx[r].col(i) / (h * h);
+  // Per pair: its eq. 19–20 force F_k and the response of every pair's separation to it.
+  const Eigen::Index p = static_cast<Eigen::Index>(pairs.size());
+  std::vector<VecX> forces(pairs.size(), VecX::Zero(model.num_dofs));
+  MatX w(p, p);
+  VecX eps(p), dq;
+  for (Eigen::Index k = 0; k < p; ++k) {
+    const std::vector<Matrix3X> dx = CalcContactDisplacements({pairs[k]}, inverse_masses);
+    for (std::size_t r = 0; r < model.rods.size(); ++r) {
+      const RodModel& rod = model.rods[r];
+      for (int i = 0; i < rod.num_nodes(); ++i)
+        forces[k].segment<3>(rod.dof_offset + NodeDof(i)) =
+            rod.mass(NodeDof(i)) * dx[r].col(i) / (h * h);
+    }
+    respond(forces[k], &dq);
+    for (Eigen::Index j = 0; j < p; ++j) w(j, k) = SeparationChange(model, pairs[j], dq);
+    eps(k) = pairs[k].penetration;
   }
+  const VecX lambda = SolveMultipliers(w, eps);
+  for (Eigen::Index k = 0; k < p; ++k) *contact_force += lambda(k) * forces[k];
   return summary;
 }
 

@@ -7,6 +7,7 @@
 // the tolerance. Clamped nodes never move.
 #pragma once
 
+#include <functional>
 #include <limits>
 
 #include "stokesrods/sim/model.h"
@@ -32,11 +33,20 @@ ContactSummary MeasureContacts(const Model& model, const VecX& q);
 /// (∞ with a single rod).
 double MinDistanceBetweenRods(const Model& model, const VecX& q);
 
+/// The linear response of the step to an extra force: dq = J⁻¹ F (J the Newton matrix).
+using LinearResponse = std::function<void(const VecX& force, VecX* dq)>;
+
 /// Detects the pairs closer than the contact distance at q. If any penetrates by more than the
-/// tolerance (model.newton.contact_tolerance × contact distance), adds the forces m Δx / h² of all
+/// tolerance (model.newton.contact_tolerance × contact distance), adds contact forces for all
 /// detected pairs to `contact_force` (global, like q); forces accumulate over the rounds of a step.
-/// Returns what it found before the correction (active = 0 means resolved).
+/// Each pair k gets a force along its normal distributed as eq. 19–20 distribute the displacement
+/// (F_k = m Δx_k / h² for its own pair alone), scaled by λ_k ≥ 0 so that, to first order, every
+/// penetration ε_j is removed: Σ_k W_jk λ_k = ε_j, with W_jk the change of the separation of pair
+/// j under dq = J⁻¹ F_k. When inertia dominates J (J ≈ M/h²), λ = 1 and this is eq. 20 itself;
+/// when the rod's stiffness or drag dominate, eq. 20 alone would close only a fraction
+/// m/(h² J) of the gap per round. Returns what it found before the correction (active = 0 means
+/// resolved).
 ContactSummary AddContactForces(const Model& model, const VecX& q, double h,
-                                VecX* contact_force);
+                                const LinearResponse& respond, VecX* contact_force);
 
 }  // namespace stokesrods

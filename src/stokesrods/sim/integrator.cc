@@ -198,7 +198,16 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
       return report;
     }
     if (!model.contact) break;
-    report.contact = AddContactForces(model, ws->q, h, &ws->contact_force);
+    if (!ws->factors_valid || ws->factors_h != h) {  // the response needs the Newton matrix
+      Evaluate(model, *state, h, ws->q, true, ws, &ws->frames, &ws->residual);
+      ws->factors_valid = FactorizeJacobian(model, h, ws);
+      ws->factors_h = h;
+      ws->factors_age = 0;
+    }
+    const LinearResponse respond = [&](const VecX& force, VecX* dq) {
+      NewtonCorrection(model, h, -force, ws, dq);  // −J⁻¹(−F) = J⁻¹ F
+    };
+    report.contact = AddContactForces(model, ws->q, h, respond, &ws->contact_force);
     if (report.contact.active == 0) break;
     report.contact_pairs = std::max(report.contact_pairs, report.contact.detected);
     if (report.contact_rounds >= model.newton.max_contact_rounds) {
