@@ -1,11 +1,20 @@
 #include "stokesrods/io/build_model.h"
 
+#include <algorithm>
 #include <cmath>
+#include <complex>
+#include <limits>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "stokesrods/fluid/lsbt.h"
+#include "stokesrods/fluid/rft.h"
 #include "stokesrods/rod/geometry.h"
+#include "stokesrods/sim/hydro_coupling.h"
 #include "stokesrods/sim/contact_forces.h"
 #include "stokesrods/sim/observables.h"
 #include "stokesrods/sim/state.h"
@@ -37,7 +46,83 @@ FluidModel ParseFluidModel(const std::string& name) {
   return FluidModel::kNone;
 }
 
+// RFT coefficients, the LSBT discretization, the stability of the explicit coupling.
+void CheckFluidModel(const Config& config, Model* model) {
+  for (std::size_t r = 0; r < model->rods.size(); ++r) {
+    RodModel& rod = model->rods[r];
+    const RodConfig& rc = config.rods[r];
+    const std::string key = fmt::format("rods.{}", r + 1);
+    if (model->fluid.model == FluidModel::kRft) {
+      // Lighthill's coefficients with the wavelength along the filament: one helical turn, or
+      // the whole rod for other shapes.
+      const double wavelength = rc.shape == "helix"
+                                    ? std::hypot(rc.pitch, 2.0 * kPi * rc.helix_radius)
+                                    : rod.rest_edge_length.sum();
+      try {
+        const RftCoefficients c = LighthillCoefficients(model->fluid.viscosity, rod.radius, wavelength);
+        rod.rft_coefficients = Vec2(c.parallel, c.perpendicular);
+      } catch (const std::invalid_argument& e) {
+        throw ConfigError(config.file, key + ".radius", e.what());
+      }
+    }
+    if (model->fluid.model == FluidModel::kLsbt) {
+      const LsbtDiscretizationCheck check = CheckLsbtDiscretization(rod.rest_positions, rod.radius);
+      // The helix's connecting edge x1 → x2 (length R√2) is part of the paper's geometry.
+      const int allowed = rc.shape == "helix" ? 1 : 0;
+      if (check.edges_outside > allowed)
+        throw ConfigError(
+            config.file, key + ".nodes",
+            fmt::format("fluid.model = \"lsbt\" assumes edges of length 2δ = r0√e = {:.4g} m, "
+                        "but {} edges differ by more than 5% (up to {:.0f}%); N = {} fits",
+                        check.target_edge_length, check.edges_outside,
+                        100.0 * check.max_relative_deviation, check.suggested_nodes));
+    }
+  }
+  if (model->coupling != FluidCoupling::kExplicit ||
+      (model->fluid.model != FluidModel::kRss && model->fluid.model != FluidModel::kLsbt))
+    return;
+  const double limit = ExplicitStepLimit(*model);
+  if (config.run.time_step > limit)
+    throw ConfigError(config.file, "run.time_step",
+                      fmt::format("fluid.coupling = \"explicit\" is stable only for a time step "
+                                  "up to {:.3g} s (2 m/c for these masses and drag); got {:.3g} s. "
+                                  "Use a smaller step or coupling = \"implicit\"",
+                                  limit, config.run.time_step));
+}
+
 }  // namespace
+
+double ExplicitStepLimit(const Model& model) {
+  // The drag in the explicit step is forward Euler on M v̇ = −R v over the free nodes, with
+  // R = (𝕄⁻¹)_ff: stable while |1 − h λ| ≤ 1 for every eigenvalue λ of M_f⁻¹ R, i.e.
+  // h ≤ 2 Re λ / |λ|².
+  const State rest = MakeRestState(model);
+  std::vector<Matrix3X> positions;
+  for (int r = 0; r < static_cast<int>(model.rods.size()); ++r)
+    positions.push_back(RodPositions(model, r, rest.q));
+  MatX mobility;
+  AssembleMobility(model.fluid, MakeHydroRods(model, positions), &mobility);
+  const MatX resistance = mobility.partialPivLu().inverse();
+  std::vector<Eigen::Index> free;
+  VecX mass;
+  std::vector<double> masses;
+  for (const RodModel& rod : model.rods)
+    for (int i = 0; i < rod.num_nodes(); ++i)
+      for (int c = 0; c < 3; ++c)
+        if (!std::binary_search(rod.fixed_dofs.begin(), rod.fixed_dofs.end(), NodeDof(i) + c)) {
+          free.push_back(3 * (rod.node_offset + i) + c);
+          masses.push_back(rod.mass(NodeDof(i) + c));
+        }
+  const Eigen::Index n = static_cast<Eigen::Index>(free.size());
+  MatX a(n, n);
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (Eigen::Index j = 0; j < n; ++j) a(i, j) = resistance(free[i], free[j]) / masses[i];
+  const Eigen::VectorXcd lambda = a.eigenvalues();
+  double limit = std::numeric_limits<double>::infinity();
+  for (const std::complex<double>& l : lambda)
+    if (l.real() > 0.0) limit = std::min(limit, 2.0 * l.real() / std::norm(l));
+  return limit;
+}
 
 Model BuildModel(const Config& config) {
   Model model;
@@ -84,10 +169,7 @@ Model BuildModel(const Config& config) {
   }
   FinalizeLayout(&model);
 
-  if (model.fluid.model == FluidModel::kLsbt || model.fluid.model == FluidModel::kRft)
-    throw ConfigError(config.file, "fluid.model",
-                      fmt::format("\"{}\" is not available yet in this version (use \"rss\" or "
-                                  "\"none\")", config.fluid.model));
+  CheckFluidModel(config, &model);
 
   // Rods overlapping at the start.
   for (std::size_t a = 0; a < model.rods.size(); ++a)

@@ -24,6 +24,11 @@ struct RunPlan {
 /// (rods overlapping at the start, a model not available, ...).
 Model BuildModel(const Config& config);
 
+/// The largest time step for which fluid.coupling = "explicit" is stable at the rest shape [s]
+/// (the drag as forward Euler on the free nodes: h ≤ 2 Re λ/|λ|² over the eigenvalues λ of
+/// M⁻¹ (𝕄⁻¹)_ff, about 2 m/c for node mass m and node drag coefficient c).
+double ExplicitStepLimit(const Model& model);
+
 RunPlan MakeRunPlan(const Config& config, const Model& model);
 
 /// The derived quantities as a JSON object text: EI, GJ, EA per rod, time_scale, omega and
