@@ -35,17 +35,32 @@ struct HydroRod {
   double rft_perpendicular = 0.0;
 };
 
-/// Voronoi lengths of the nodes of a polyline (3 × N): half the adjacent edge lengths summed [m].
+/// Voronoi lengths of the nodes of a polyline (3 × N, N ≥ 2): half the adjacent edge lengths
+/// summed [m] (the end nodes get half their one edge).
 VecX VoronoiLengths(const Matrix3X& x);
+
+/// Unit tangents at the nodes of a polyline (3 × N, N ≥ 2, no zero-length edge): the normalized
+/// sum of the unit tangents of the adjacent edges; the end nodes take their one edge's. Used by
+/// the local terms of LSBT (f⊥) and RFT.
+Matrix3X NodeTangents(const Matrix3X& x);
+
+/// Total number of nodes M of the rods.
+Eigen::Index TotalNodes(const std::vector<HydroRod>& rods);
 
 /// Nodal mobility 𝕄 (3M × 3M) of the model for the rods as they are now [m/(N·s)].
 /// kNone is a programmer error. RFT gives the block-diagonal inverse of its local resistance.
+///   rss : 𝕄 = A Λ⁻¹ (rss.h), ε = params.regularization × the radius of the rod that owns the
+///         segment. 𝕄 is not symmetric (collocation of linear densities): solve it with LU, not
+///         with a factorization that reads one triangle (LDLT, LLT).
+///   lsbt: eq. C.2 (lsbt.h); symmetric but not positive definite at Δ = 2δ.
+///   rft : rft.h.
 void AssembleMobility(const FluidParams& params, const std::vector<HydroRod>& rods,
                       MatX* mobility);
 
 /// Fluid velocity [m/s] at `point` induced by the nodal forces F (3M, as in U = 𝕄 F) of a solved
-/// state: RSS evaluates the segments of eq. 9 with the force densities F_i/Δl_i; LSBT and RFT use
-/// the (singular) Stokeslets of the nodal forces.
+/// state: RSS evaluates the segments of eq. 9 with the force densities F_i/Δl_i (so at a node it
+/// returns that node's velocity, the no-slip condition the solve imposed); LSBT and RFT use the
+/// (singular) Stokeslets of the nodal forces, leaving out a node that coincides with `point`.
 Vec3 FluidVelocityAt(const FluidParams& params, const std::vector<HydroRod>& rods,
                      const VecX& nodal_forces, const Vec3& point);
 
