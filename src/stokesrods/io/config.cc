@@ -54,6 +54,14 @@ void VisitFields(SolverConfig& c, V& v) {
   v("damping", c.damping);
 }
 template <class V>
+void VisitFields(FlowFieldConfig& c, V& v) {
+  v("times", c.times);
+  v("origin", c.origin);
+  v("u", c.u);
+  v("v", c.v);
+  v("resolution", c.resolution);
+}
+template <class V>
 void VisitFields(PointLoadConfig& c, V& v) {
   v("node", c.node);
   v("force", c.force);
@@ -146,6 +154,21 @@ class Reader {
     if (a == nullptr || a->size() != 3) Wrong(path, "an array of 3 numbers", n);
     for (int k = 0; k < 3; ++k) Read(*a->get(k), fmt::format("{}[{}]", path, k), &(*out)(k));
   }
+  template <class T>
+  void ReadList(const toml::node& n, const std::string& path, std::vector<T>* out,
+                const char* expected) const {
+    const toml::array* a = n.as_array();
+    if (a == nullptr) Wrong(path, expected, n);
+    out->assign(a->size(), T{});
+    for (std::size_t i = 0; i < a->size(); ++i)
+      Read(*a->get(i), fmt::format("{}[{}]", path, i), &(*out)[i]);
+  }
+  void Read(const toml::node& n, const std::string& path, std::vector<double>* out) const {
+    ReadList(n, path, out, "an array of numbers");
+  }
+  void Read(const toml::node& n, const std::string& path, std::vector<int>* out) const {
+    ReadList(n, path, out, "an array of integers");
+  }
   void Read(const toml::node& n, const std::string& path, std::vector<Vec3>* out) const {
     const toml::array* a = n.as_array();
     if (a == nullptr) Wrong(path, "an array of [x, y, z] points", n);
@@ -193,6 +216,16 @@ class Writer {
   }
   static toml::array Array(const Vec3& v) { return toml::array{v.x(), v.y(), v.z()}; }
   void Write(const char* key, const Vec3& v) { table_->insert_or_assign(key, Array(v)); }
+  void Write(const char* key, std::vector<double>& v) {
+    toml::array a;
+    for (double x : v) a.push_back(x);
+    table_->insert_or_assign(key, std::move(a));
+  }
+  void Write(const char* key, std::vector<int>& v) {
+    toml::array a;
+    for (int x : v) a.push_back(x);
+    table_->insert_or_assign(key, std::move(a));
+  }
   void Write(const char* key, std::vector<Vec3>& v) {
     if (v.empty()) return;
     toml::array a;
@@ -237,6 +270,7 @@ toml::table ToTable(Config& c) {
   section("contact", c.contact);
   section("gravity", c.gravity);
   section("solver", c.solver);
+  section("flow_field", c.flow_field);
   toml::array rods;
   for (RodConfig& r : c.rods) {
     toml::table t;
@@ -324,17 +358,19 @@ Config ParseConfig(const std::string& toml_text, const std::string& file,
 
   Config config;
   config.file = file;
-  static const std::set<std::string> kSections = {"run",    "fluid", "contact",
-                                                  "gravity", "solver", "rods"};
+  static const std::set<std::string> kSections = {"run",    "fluid",  "contact",   "gravity",
+                                                  "solver", "flow_field", "rods"};
   for (const auto& [key, node] : root)
     if (kSections.count(std::string(key.str())) == 0)
       throw ConfigError(file, std::string(key.str()),
-                        "unknown section (known: run, fluid, contact, gravity, solver, rods)");
+                        "unknown section (known: run, fluid, contact, gravity, solver, "
+                        "flow_field, rods)");
   ReadSection(root, "run", file, &config.run);
   ReadSection(root, "fluid", file, &config.fluid);
   ReadSection(root, "contact", file, &config.contact);
   ReadSection(root, "gravity", file, &config.gravity);
   ReadSection(root, "solver", file, &config.solver);
+  ReadSection(root, "flow_field", file, &config.flow_field);
   const toml::node* rods = root.get("rods");
   if (rods == nullptr) throw ConfigError(file, "rods", "missing: at least one [[rods]] is required");
   if (!rods->is_array_of_tables()) throw ConfigError(file, "rods", "expected [[rods]] tables");

@@ -61,6 +61,15 @@ struct SolverConfig {
   double damping = 0.0;             ///< isotropic viscous damping per unit length [Pa·s]
 };
 
+/// The fluid velocity on a plane grid at chosen times (paper Fig. 6b).
+struct FlowFieldConfig {
+  std::vector<double> times;                   ///< [s]; empty: no flow field
+  Vec3 origin = Vec3(-0.02, 0.0, -0.23);       ///< a corner of the plane [m]
+  Vec3 u = Vec3(0.07, 0.0, 0.0);               ///< first edge of the plane [m]
+  Vec3 v = Vec3(0.0, 0.0, 0.25);               ///< second edge of the plane [m]
+  std::vector<int> resolution = {36, 126};     ///< grid points along u and along v
+};
+
 struct PointLoadConfig {
   int node = 0;
   Vec3 force = Vec3::Zero();  ///< [N]
@@ -92,6 +101,7 @@ struct Config {
   ContactConfig contact;
   GravityConfig gravity;
   SolverConfig solver;
+  FlowFieldConfig flow_field;
   std::vector<RodConfig> rods;
 };
 

@@ -115,6 +115,21 @@ void ValidateConfig(Config* config) {
   c.Range("solver.jacobian_max_age", config->solver.jacobian_max_age, 0, 1000000);
   c.NonNegative("solver.damping", config->solver.damping);
 
+  const FlowFieldConfig& flow = config->flow_field;
+  for (std::size_t i = 0; i < flow.times.size(); ++i)
+    c.NonNegative(fmt::format("flow_field.times[{}]", i), flow.times[i]);
+  c.Finite("flow_field.origin", flow.origin);
+  c.Finite("flow_field.u", flow.u);
+  c.Finite("flow_field.v", flow.v);
+  if (flow.resolution.size() != 2)
+    throw ConfigError(c.file, "flow_field.resolution", "expected two integers [along u, along v]");
+  c.Range("flow_field.resolution[0]", flow.resolution[0], 2, 100000);
+  c.Range("flow_field.resolution[1]", flow.resolution[1], 2, 100000);
+  if (!flow.times.empty() && flow.u.cross(flow.v).norm() == 0.0)
+    throw ConfigError(c.file, "flow_field.v", "the plane's edges u and v must not be parallel");
+  if (!flow.times.empty() && config->fluid.model == "none")
+    throw ConfigError(c.file, "flow_field.times", "a flow field needs a fluid model");
+
   if (config->rods.empty()) throw ConfigError(c.file, "rods", "at least one [[rods]] is required");
   for (std::size_t i = 0; i < config->rods.size(); ++i)
     ValidateRod(c, fmt::format("rods.{}", i + 1), &config->rods[i]);

@@ -1,5 +1,6 @@
 #include "stokesrods/io/runner.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "stokesrods/io/build_model.h"
+#include "stokesrods/io/flow_field.h"
 #include "stokesrods/io/writers.h"
 #include "stokesrods/sim/integrator.h"
 #include "stokesrods/sim/observables.h"
@@ -141,6 +143,18 @@ RunResult RunCase(const Config& config, const RunOptions& options) {
     // state has zero elastic force and no velocity.
     observer.Record(state, ws, report);
   }
+  // Flow planes: at the first step that reaches each requested time.
+  std::vector<double> flow_times = config.flow_field.times;
+  std::sort(flow_times.begin(), flow_times.end());
+  std::size_t next_flow = 0;
+  while (next_flow < flow_times.size() && flow_times[next_flow] < state.time - 0.5 * h) ++next_flow;
+  auto write_flow = [&] {
+    while (next_flow < flow_times.size() && flow_times[next_flow] <= state.time + 0.5 * h) {
+      WriteFlowField(model, state, config.flow_field, plan.output_dir, static_cast<int>(next_flow));
+      ++next_flow;
+    }
+  };
+  write_flow();
   double last_progress = -1.0;
   while (state.step < total_steps) {
     if (options.interrupted && options.interrupted()) {
@@ -159,6 +173,7 @@ RunResult RunCase(const Config& config, const RunOptions& options) {
     max_penetration = std::max(max_penetration, report.contact.max_penetration);
     if (state.step % output_every == 0 || state.step == total_steps) observer.Record(state, ws, report);
     if (state.step % checkpoint_every == 0) SaveCheckpoint(checkpoint, state);
+    write_flow();
     if (options.progress && wall() - last_progress >= 0.2) {
       last_progress = wall();
       options.progress({state.time, plan.duration, last_progress, state.step});

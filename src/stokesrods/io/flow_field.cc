@@ -1,0 +1,55 @@
+#include "stokesrods/io/flow_field.h"
+
+#include <filesystem>
+
+#include <Eigen/LU>
+#include <fmt/format.h>
+
+#include "stokesrods/io/writers.h"
+#include "stokesrods/sim/hydro_coupling.h"
+
+namespace stokesrods {
+
+namespace fs = std::filesystem;
+
+std::string WriteFlowField(const Model& model, const State& state, const FlowFieldConfig& plane,
+                           const std::string& output_dir, int index) {
+  std::vector<Matrix3X> positions;
+  for (int r = 0; r < static_cast<int>(model.rods.size()); ++r)
+    positions.push_back(RodPositions(model, r, state.q));
+  const std::vector<HydroRod> rods = MakeHydroRods(model, positions);
+  MatX mobility;
+  AssembleMobility(model.fluid, rods, &mobility);
+  VecX u;
+  GatherNodeVelocities(model, state.velocity, VecX::Zero(state.velocity.size()), 1.0, &u);
+  const VecX forces = mobility.partialPivLu().solve(u);  // on the fluid
+
+  const int nu = plane.resolution[0], nv = plane.resolution[1];
+  std::string vts = fmt::format(
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"StructuredGrid\" version=\"0.1\">\n"
+      "<StructuredGrid WholeExtent=\"0 {0} 0 {1} 0 0\">\n<Piece Extent=\"0 {0} 0 {1} 0 0\">\n",
+      nu - 1, nv - 1);
+  std::string points, velocity, csv = "x,y,z,ux,uy,uz\n";
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) {
+      const Vec3 x = plane.origin + plane.u * i / (nu - 1.0) + plane.v * j / (nv - 1.0);
+      const Vec3 w = FluidVelocityAt(model.fluid, rods, forces, x);
+      points += fmt::format("{:.8g} {:.8g} {:.8g}\n", x.x(), x.y(), x.z());
+      velocity += fmt::format("{:.8g} {:.8g} {:.8g}\n", w.x(), w.y(), w.z());
+      csv += fmt::format("{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g}\n", x.x(), x.y(), x.z(), w.x(),
+                         w.y(), w.z());
+    }
+  vts += "<PointData Vectors=\"velocity\">\n<DataArray type=\"Float64\" Name=\"velocity\" "
+         "NumberOfComponents=\"3\" format=\"ascii\">\n" + velocity + "</DataArray>\n</PointData>\n";
+  vts += "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n" +
+         points + "</DataArray>\n</Points>\n</Piece>\n</StructuredGrid>\n</VTKFile>\n";
+  std::error_code ec;
+  fs::create_directories(fs::path(output_dir) / "flow", ec);
+  if (ec) throw IoError(fmt::format("{}/flow: cannot create: {}", output_dir, ec.message()));
+  const std::string name = fmt::format("flow/flow_{:05d}", index);
+  WriteFileAtomically((fs::path(output_dir) / (name + ".vts")).string(), vts);
+  WriteFileAtomically((fs::path(output_dir) / (name + ".csv")).string(), csv);
+  return name + ".vts";
+}
+
+}  // namespace stokesrods
