@@ -22,24 +22,27 @@
 #include "stokesrods/fluid/stokeslet_segment.h"
 
 #include <array>
+#include <algorithm>
 #include <cmath>
+#include <complex>
 
 #include "stokesrods/common/assert.h"
 
 namespace stokesrods {
 namespace {
 
-constexpr int kFarFieldPoints = 20;
+constexpr int kFarFieldPoints = 20;  // the most points a far-field rule uses
 
 struct GaussLegendreRule {
   std::array<double, kFarFieldPoints> node{};    // on [0, 1]
   std::array<double, kFarFieldPoints> weight{};  // sum 1
+  int size = 0;
 };
 
 // Nodes of P_n by Newton from the Chebyshev guesses; mapped to [0, 1].
-GaussLegendreRule MakeGaussLegendreRule() {
+GaussLegendreRule MakeGaussLegendreRule(int n) {
   GaussLegendreRule rule;
-  const int n = kFarFieldPoints;
+  rule.size = n;
   for (int i = 0; i < n; ++i) {
     double x = std::cos(kPi * (i + 0.75) / (n + 0.5));
     double dp = 1.0;
@@ -129,11 +132,34 @@ Mat3 WeightedSegmentMatrix(const Moments& m, double c0, double c1, double length
   return length * a;
 }
 
+// Gauss–Legendre rules with 1 … kFarFieldPoints points.
+const GaussLegendreRule& Rule(int n) {
+  static const std::array<GaussLegendreRule, kFarFieldPoints + 1> rules = [] {
+    std::array<GaussLegendreRule, kFarFieldPoints + 1> r{};
+    for (int k = 1; k <= kFarFieldPoints; ++k) r[static_cast<size_t>(k)] = MakeGaussLegendreRule(k);
+    return r;
+  }();
+  return rules[static_cast<size_t>(n)];
+}
+
+// Points for n-point Gauss–Legendre to reach round-off on the integrand of eq. 8. Its nearest
+// singularities are at α = α* ± i d/L (R_α = 0, d² = |r⊥|² + ε²); on z = 2α − 1 ∈ [−1, 1] they lie
+// on the Bernstein ellipse of parameter ρ = |z0 + √(z0² − 1)|, and the error falls like ρ^(−2n):
+// n = ln(1e-16)/(−2 ln ρ), plus two for the algebraic prefactor of the R⁻³ singularity.
+int FarFieldPointCount(double alpha_star, double d_over_length) {
+  const std::complex<double> z0(2.0 * alpha_star - 1.0, 2.0 * d_over_length);
+  std::complex<double> w = z0 + std::sqrt(z0 * z0 - 1.0);
+  if (std::abs(w) < 1.0) w = z0 - std::sqrt(z0 * z0 - 1.0);
+  const double log_rho = std::log(std::abs(w));
+  const int n = static_cast<int>(std::ceil(36.8 / (2.0 * log_rho))) + 2;
+  return std::clamp(n, 3, kFarFieldPoints);
+}
+
 SegmentMobility FarFieldSegment(const Vec3& xa, const Vec3& v, double length, double eps,
-                                const Vec3& point) {
-  static const GaussLegendreRule rule = MakeGaussLegendreRule();
+                                const Vec3& point, int points) {
+  const GaussLegendreRule& rule = Rule(points);
   SegmentMobility out;
-  for (size_t q = 0; q < rule.node.size(); ++q) {
+  for (size_t q = 0; q < static_cast<size_t>(rule.size); ++q) {
     const double alpha = rule.node[q];
     const Mat3 s = (rule.weight[q] * length) * RegularizedStokesletMatrix(point - xa - alpha * v, eps);
     out.a += (1.0 - alpha) * s;
@@ -173,7 +199,11 @@ SegmentMobility StokesletSegment(const Vec3& xa, const Vec3& xb, double regulari
   const Vec3 r_perp = ra - alpha_star * v;   // ⟂ v; r_α = r⊥ − (α − α*) v
   const double along = alpha_star < 0.0 ? -alpha_star : (alpha_star > 1.0 ? alpha_star - 1.0 : 0.0);
   const double distance2 = r_perp.squaredNorm() + along * along * l2;
-  if (distance2 + eps * eps >= l2) return FarFieldSegment(xa, v, length, eps, point);
+  if (distance2 + eps * eps >= l2) {
+    const double d_over_length = std::sqrt((r_perp.squaredNorm() + eps * eps) / l2);
+    return FarFieldSegment(xa, v, length, eps, point,
+                           FarFieldPointCount(alpha_star, d_over_length));
+  }
 
   const double d = std::sqrt(r_perp.squaredNorm() + eps * eps);
   const Moments m = CalcMoments(length, d, -alpha_star, 1.0 - alpha_star);
