@@ -1,0 +1,111 @@
+#!/usr/bin/python3
+"""Paper section 3 (Fig. 5, Fig. C.11, appendix B): the buckling of one rotating helix.
+
+  buckling.py sweep   [--model rss|lsbt] [--h H]   l̄ at t̄ = 1 against ω̄, and the bisection of ω̄_b
+  buckling.py series                               l̄(t̄) at ω̄ = 533 and 1067 (Fig. 5c1)
+  buckling.py convergence                          N ∈ {43, 65, 81}, h ∈ {1e-2, 1e-3, 1e-4}
+  buckling.py explicit                             explicit h = 0.2 ms against implicit h = 1 ms
+  buckling.py timing                               compute time per simulated second
+
+Buckled or not: the helix has lost its shape when the tip leaves the rotation axis. We use the
+largest distance of the last node from the vertical through the clamp over the last 20 % of the
+run, against 2R (R = 1 cm): a stable helix keeps its tip within about R of the axis, a buckled one
+tilts and swings out (the end-to-end length alone can stay near 1 while the axis tilts).
+Outputs go to out/studies/buckling/ and docs/validation/.
+"""
+import argparse
+import os
+
+import numpy as np
+
+from common import ROOT, log, run_all, timeseries
+
+OUT = os.path.join(ROOT, "out", "studies", "buckling")
+DOCS = os.path.join(ROOT, "docs", "validation")
+R = 0.01
+
+
+def case(model, omega_bar, nodes, h, t_end=1.0, coupling="implicit", tag=""):
+    name = f"{model}_N{nodes}_h{h:g}_w{omega_bar:g}{tag}"
+    overrides = {"rods.omega_bar": omega_bar, "rods.nodes": nodes, "fluid.model": model,
+                 "fluid.coupling": coupling, "run.time_step": h, "run.t_bar_end": t_end,
+                 "run.output_interval": max(h, 0.5), "run.frames": "false",
+                 "run.checkpoint_interval": 50.0}
+    return ("examples/helix.toml", os.path.join(OUT, name), overrides)
+
+
+def measure(out, fraction=0.2):
+    ts = timeseries(out)
+    tail = ts["t_bar"] >= ts["t_bar"][-1] * (1.0 - fraction)
+    return {"t_bar": ts["t_bar"][-1], "l_bar": ts["rod1_length_bar"][-1],
+            "tip": np.max(ts["rod1_tip_axis_distance"][tail]),
+            "thrust_bar": ts["propulsive_force_bar"][-1]}
+
+
+def buckled(m):
+    return m["tip"] > 2.0 * R
+
+
+def sweep(model, nodes, h, omegas, lo, hi, tol):
+    cases = [case(model, w, nodes, h) for w in omegas]
+    run_all(cases)
+    rows = [(w, measure(c[1])) for w, c in zip(omegas, cases)]
+    # Bisection on ω̄_b between the largest stable and the smallest buckled sweep point.
+    while hi - lo > tol:
+        mids = [lo + (hi - lo) / 3.0, lo + 2.0 * (hi - lo) / 3.0]  # two at a time
+        cs = [case(model, round(w, 1), nodes, h) for w in mids]
+        run_all(cs)
+        ms = [measure(c[1]) for c in cs]
+        rows += [(round(w, 1), m) for w, m in zip(mids, ms)]
+        flags = [buckled(m) for m in ms]
+        if flags[0]:
+            hi = mids[0]
+        elif flags[1]:
+            lo, hi = mids[0], mids[1]
+        else:
+            lo = mids[1]
+        log(f"{model}: omega_b in [{lo:.1f}, {hi:.1f}]")
+    rows.sort(key=lambda r: r[0])
+    path = os.path.join(DOCS, f"buckling_{model}_N{nodes}_h{h:g}.csv")
+    with open(path, "w") as f:
+        f.write("omega_bar,l_bar_at_t1,tip_axis_distance_max_over_R,propulsive_force_bar,buckled\n")
+        for w, m in rows:
+            f.write(f"{w},{m['l_bar']:.6f},{m['tip'] / R:.4f},{m['thrust_bar']:.5g},{int(buckled(m))}\n")
+    log(f"{model} N={nodes} h={h}: omega_b in [{lo:.1f}, {hi:.1f}] -> {path}")
+    return lo, hi
+
+
+def main():
+    p = argparse.ArgumentParser()
+    p.add_argument("what", choices=["sweep", "series", "convergence", "explicit", "timing"])
+    p.add_argument("--model", default="rss")
+    p.add_argument("--h", type=float, default=1e-2)
+    p.add_argument("--nodes", type=int, default=0)
+    args = p.parse_args()
+    os.makedirs(DOCS, exist_ok=True)
+    if args.what == "sweep":
+        nodes = args.nodes or (195 if args.model == "lsbt" else 65)
+        omegas = [100, 200, 300, 400, 500, 533, 600, 700, 800, 900, 1067]
+        sweep(args.model, nodes, args.h, omegas, 600, 700, 10 if args.model == "rss" else 20)
+    elif args.what == "series":
+        cs = [case("rss", w, 65, args.h) for w in (533, 1067)]
+        run_all(cs)
+    elif args.what == "convergence":
+        cs = [case("rss", w, n, 1e-2) for n in (43, 81) for w in (300, 533, 700, 900)]
+        cs += [case("rss", 533, 65, h, t_end=0.1, tag="_short") for h in (1e-2, 1e-3, 1e-4)]
+        run_all(cs)
+    elif args.what == "explicit":
+        cs = [case("rss", 533, 65, 2e-4, t_end=0.1, coupling="explicit", tag="_short"),
+              case("rss", 533, 65, 1e-3, t_end=0.1, tag="_short")]
+        run_all(cs)
+    elif args.what == "timing":
+        cs = [case("rss", 533, 65, 1e-3, t_end=0.01, tag="_timing"),
+              case("lsbt", 533, 195, 1e-3, t_end=0.01, tag="_timing"),
+              case("rss", 533, 65, 1e-2, t_end=0.01, tag="_timing"),
+              case("lsbt", 533, 195, 1e-2, t_end=0.01, tag="_timing")]
+        for c in cs:
+            run_all([c])
+
+
+if __name__ == "__main__":
+    main()
