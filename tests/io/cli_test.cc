@@ -103,6 +103,23 @@ TEST(Cli, NumericalFailureIsExitThreeWithTheLastGoodStateSaved) {
   EXPECT_TRUE(fs::exists(out / "checkpoint.bin"));
 }
 
+TEST(Cli, InterruptFlushesWritesACheckpointAndExits130) {
+  const fs::path out = fs::temp_directory_path() / "stokesrods_cli_interrupt";
+  fs::remove_all(out);
+  const fs::path cfg = WriteConfig("long.toml", "[run]\nduration = 1000.0\ntime_step = 0.01\n"
+                                                "[fluid]\nmodel = \"rss\"\n[[rods]]\nnodes = 21\n"
+                                                "omega_bar = 500\n");
+  const std::string cmd = "timeout --preserve-status -s INT 1 " + std::string(STOKESRODS_BINARY) +
+                          " run " + cfg.string() + " --output " + out.string() +
+                          " > /dev/null 2>&1 < /dev/null";
+  const int status = std::system(cmd.c_str());
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  const nlohmann::json summary = nlohmann::json::parse(Read(out / "summary.json"));
+  EXPECT_EQ(summary["status"], "interrupted");
+  EXPECT_GT(summary["steps"].get<long>(), 0);
+  EXPECT_TRUE(fs::exists(out / "checkpoint.bin"));
+}
+
 TEST(Cli, ResumeContinuesFromTheCheckpointAsIfNeverStopped) {
   const std::string base = "[run]\ntime_step = 0.01\noutput_interval = 0.05\n"
                            "checkpoint_interval = 0.1\n[fluid]\nmodel = \"rss\"\n"
