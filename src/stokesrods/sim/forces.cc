@@ -1,5 +1,6 @@
 #include "stokesrods/sim/forces.h"
 
+#include "stokesrods/common/assert.h"
 #include "stokesrods/fluid/hydrodynamics.h"
 
 namespace stokesrods {
@@ -40,6 +41,7 @@ void LocalDrag::CalcResistance(const Model& model, const VecX& q_start,
 void LocalDrag::AddTo(const Model& model, const StepContext& ctx, const VecX& q, VecX* force,
                       std::vector<BandedMatrix>* jacobian) const {
   if (ctx.time_step <= 0.0) return;  // static: no velocity, no drag
+  SR_ASSERT(blocks_.rows() == 3 * model.num_nodes, "LocalDrag::Prepare was not called");
   const double h = ctx.time_step;
   for (std::size_t r = 0; r < model.rods.size(); ++r) {
     const RodModel& rod = model.rods[r];

@@ -176,15 +176,23 @@ NewtonReport SolveNewton(const Model& model, const State& start, double h, Works
 
 }  // namespace
 
-StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
-  StepReport report;
-  for (const auto& f : ws->local_forces) f->Prepare(model, state->q);
-  if (ws->nonlocal_fluid) ws->hydro.Prepare(model, state->q, state->velocity);
+void PrepareStep(const Model& model, const State& start, Workspace* ws) {
+  for (const auto& f : ws->local_forces) f->Prepare(model, start.q);
+  if (ws->nonlocal_fluid) ws->hydro.Prepare(model, start.q, start.velocity);
   ws->contact_force.setZero();
   ws->load_factor = 1.0;
+}
+
+StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
+  StepReport report;
+  PrepareStep(model, *state, ws);
 
   for (report.contact_rounds = 1;; ++report.contact_rounds) {
-    ws->q = state->q + h * state->velocity;  // Algorithm 1's guess
+    // Algorithm 1's guess q_k + h q̇_k, plus ½h² q̈_k once two velocities are known: rods that
+    // turn by a sizeable angle per step move on circles, which the linear guess misses.
+    ws->q = state->q + h * state->velocity;
+    if (ws->previous_velocity.size() == state->velocity.size())
+      ws->q += 0.5 * h * (state->velocity - ws->previous_velocity);
     for (const RodModel& rod : model.rods)
       for (int k : rod.fixed_dofs) ws->q(rod.dof_offset + k) = state->q(rod.dof_offset + k);
     DriveBoundaryConditions(model, h, &ws->q);
@@ -221,6 +229,7 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
   }
   if (model.contact) report.contact = MeasureContacts(model, ws->q);
 
+  ws->previous_velocity = state->velocity;
   state->velocity = (ws->q - state->q) / h;
   state->q = ws->q;
   std::swap(state->rods, ws->frames);

@@ -51,6 +51,7 @@ struct Workspace {
   VecX force;                    ///< F_int + F_ext + F^h + F^c at q (after a converged solve)
   VecX residual, residual_try, delta, simplified;
   VecX contact_force;            ///< F^c, constant during a Newton solve
+  VecX previous_velocity;        ///< q̇(t_{k−1}), for the second-order predictor
   std::vector<BandedMatrix> jacobian;  ///< per rod
   double load_factor = 1.0;      ///< static load continuation
   // Reuse of the factorized Newton matrix across iterations and steps (modified Newton).
@@ -58,6 +59,10 @@ struct Workspace {
   double factors_h = -1.0;       ///< the step size they were built for (0: static)
   int factors_age = 0;           ///< steps since they were built
 };
+
+/// What depends on the start of a step only: the local forces' caches, the mobility 𝕄 at q_k (and
+/// the explicit drag), the contact force reset. Step calls it; Evaluate needs it first.
+void PrepareStep(const Model& model, const State& start, Workspace* ws);
 
 /// The residual r(q) of the step from `start` (h = 0: the static problem, without inertia and
 /// velocity-dependent forces) with the frames transported to q into `frames`, and, when
