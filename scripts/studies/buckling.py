@@ -6,6 +6,7 @@
   buckling.py convergence                          N ∈ {43, 65, 81}, h ∈ {1e-2, 1e-3, 1e-4}
   buckling.py explicit                             explicit h = 0.2 ms against implicit h = 1 ms
   buckling.py timing                               compute time per simulated second
+  buckling.py sense                                the other sense of rotation, and RFT in both
 
 Buckled or not: the helix has lost its shape when the tip leaves the rotation axis. We use the
 largest distance of the last node from the vertical through the clamp over the last 20 % of the
@@ -77,7 +78,8 @@ def sweep(model, nodes, h, omegas, lo, hi, tol):
 
 def main():
     p = argparse.ArgumentParser()
-    p.add_argument("what", choices=["sweep", "series", "convergence", "explicit", "timing"])
+    p.add_argument("what", choices=["sweep", "series", "convergence", "explicit", "timing",
+                                    "sense"])
     p.add_argument("--model", default="rss")
     p.add_argument("--h", type=float, default=1e-2)
     p.add_argument("--nodes", type=int, default=0)
@@ -85,13 +87,26 @@ def main():
     os.makedirs(DOCS, exist_ok=True)
     if args.what == "sweep":
         nodes = args.nodes or (195 if args.model == "lsbt" else 65)
-        omegas = [100, 200, 300, 400, 500, 533, 600, 700, 800, 900, 1067]
-        sweep(args.model, nodes, args.h, omegas, 600, 700, 10 if args.model == "rss" else 20)
+        if args.model == "rss":
+            omegas = [100, 200, 300, 400, 500, 533, 600, 700, 800, 900, 1067]
+            sweep(args.model, nodes, args.h, omegas, 600, 700, 10)
+        else:
+            sweep(args.model, nodes, args.h, [500, 600, 700, 800], 600, 700, 20)
     elif args.what == "series":
         cs = [case("rss", w, 65, args.h) for w in (533, 1067)]
         run_all(cs)
+    elif args.what == "sense":
+        cs = [case("rss", w, 65, 1e-2, t_end=0.5) for w in (-100, -200, -300, -533)]
+        cs += [case("rft", w, 65, 1e-2, t_end=0.5) for w in (-533, 533)]
+        run_all(cs)
+        with open(os.path.join(DOCS, "rotation_sense.csv"), "w") as f:
+            f.write("model,omega_bar,l_bar_at_t0.5,tip_axis_distance_max_over_R\n")
+            for c in cs:
+                m = measure(c[1])
+                f.write(f"{c[2]['fluid.model']},{c[2]['rods.omega_bar']},{m['l_bar']:.5f},"
+                        f"{m['tip'] / R:.3f}\n")
     elif args.what == "convergence":
-        cs = [case("rss", w, n, 1e-2) for n in (43, 81) for w in (300, 533, 700, 900)]
+        cs = [case("rss", w, n, 1e-2) for n in (43, 81) for w in (533, 700, 900)]
         cs += [case("rss", 533, 65, h, t_end=0.1, tag="_short") for h in (1e-2, 1e-3, 1e-4)]
         run_all(cs)
     elif args.what == "explicit":
