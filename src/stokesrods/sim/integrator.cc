@@ -129,8 +129,10 @@ double CorrectionNorm(const Model& model, const VecX& delta) {
 NewtonReport SolveNewton(const Model& model, const State& start, double h, Workspace* ws) {
   NewtonReport report;
   const double step_tolerance = 1e-10 * model.length_scale;
+  // Old factors are worth keeping while they converge a step in a few iterations; a step that
+  // needed more (a rod turning fast, a contact) rebuilds them at the start of the next.
   bool fresh = !ws->factors_valid || ws->factors_h != h ||
-               ws->factors_age >= model.newton.jacobian_max_age;
+               ws->factors_age >= model.newton.jacobian_max_age || ws->last_iterations > 3;
   Evaluate(model, start, h, ws->q, fresh, ws, &ws->frames, &ws->residual);
   bool have_jacobian = fresh;
   double norm = ResidualNorm(model, ws->residual);
@@ -143,6 +145,7 @@ NewtonReport SolveNewton(const Model& model, const State& start, double h, Works
     report.residual = norm;
     if (norm <= report.tolerance || small_correction) {
       report.converged = true;
+      ws->last_iterations = report.iterations;
       return report;
     }
     if (report.iterations == model.newton.max_iterations) return report;

@@ -58,6 +58,7 @@ struct Workspace {
   bool factors_valid = false;    ///< ws.jacobian (and the Woodbury factors) hold usable factors
   double factors_h = -1.0;       ///< the step size they were built for (0: static)
   int factors_age = 0;           ///< steps since they were built
+  int last_iterations = 0;       ///< Newton iterations of the last converged solve
 };
 
 /// What depends on the start of a step only: the local forces' caches, the mobility 𝕄 at q_k (and
