@@ -1,6 +1,8 @@
 // The command line as users and scripts see it: exit codes, messages, and the SPEC output files.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -18,18 +20,25 @@ struct Outcome {
 };
 
 Outcome RunCli(const std::string& args) {
-  const fs::path err = fs::temp_directory_path() / "stokesrods_cli_test.err";
+  // One stderr file per process and call: ctest runs these tests in parallel processes.
+  static int calls = 0;
+  const fs::path err = fs::temp_directory_path() /
+                       ("stokesrods_cli_test." + std::to_string(getpid()) + "." +
+                        std::to_string(++calls) + ".err");
   const std::string cmd = std::string(STOKESRODS_BINARY) + " " + args + " > /dev/null 2> " +
                           err.string() + " < /dev/null";
   const int status = std::system(cmd.c_str());
-  std::ifstream in(err);
   std::stringstream text;
-  text << in.rdbuf();
+  {
+    std::ifstream in(err);
+    text << in.rdbuf();
+  }
+  fs::remove(err);
   return {WEXITSTATUS(status), text.str()};
 }
 
 fs::path WriteConfig(const std::string& name, const std::string& text) {
-  const fs::path dir = fs::temp_directory_path() / "stokesrods_cli_test";
+  const fs::path dir = fs::temp_directory_path() / ("stokesrods_cli_test." + std::to_string(getpid()));
   fs::create_directories(dir);
   std::ofstream(dir / name) << text;
   return dir / name;
