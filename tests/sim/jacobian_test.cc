@@ -15,24 +15,39 @@ namespace {
 
 using testing::ModelFromToml;
 
-double JacobianError(const Model& model, const State& start, double h, const VecX& q) {
-  Workspace ws(model);
-  PrepareStep(model, start, &ws);
+// Central differences of the whole residual r(q) (frames re-transported from the start of the
+// step at every perturbed q), with identity rows and columns on the fixed DOFs as Newton has.
+MatX NumericJacobian(const Model& model, const State& start, double h, const VecX& q,
+                     double eps, Workspace* ws) {
   std::vector<RodFrames> frames;
-  VecX r0, rp, rm;
-  Evaluate(model, start, h, q, true, &ws, &frames, &r0);
-  const MatX analytic = ws.jacobian[0].ToDense();
+  VecX rp, rm;
   MatX numeric(model.num_dofs, model.num_dofs);
-  const double eps = 1e-7 * model.rods[0].rest_edge_length.minCoeff();
   for (int k = 0; k < model.num_dofs; ++k) {
     VecX qp = q, qm = q;
     qp(k) += eps;
     qm(k) -= eps;
-    Evaluate(model, start, h, qp, false, &ws, &frames, &rp);
-    Evaluate(model, start, h, qm, false, &ws, &frames, &rm);
+    Evaluate(model, start, h, qp, false, ws, &frames, &rp);
+    Evaluate(model, start, h, qm, false, ws, &frames, &rm);
     numeric.col(k) = (rp - rm) / (2 * eps);
   }
-  for (int k : model.rods[0].fixed_dofs) numeric.col(k).setZero(), numeric(k, k) = 1.0;
+  for (const RodModel& rod : model.rods)
+    for (int k : rod.fixed_dofs) {
+      numeric.col(rod.dof_offset + k).setZero();
+      numeric(rod.dof_offset + k, rod.dof_offset + k) = 1.0;
+    }
+  return numeric;
+}
+
+// One rod: the assembled banded Jacobian against NumericJacobian, relative Frobenius error.
+double JacobianError(const Model& model, const State& start, double h, const VecX& q) {
+  Workspace ws(model);
+  PrepareStep(model, start, &ws);
+  std::vector<RodFrames> frames;
+  VecX r0;
+  Evaluate(model, start, h, q, true, &ws, &frames, &r0);
+  const MatX analytic = ws.jacobian[0].ToDense();
+  const MatX numeric = NumericJacobian(model, start, h, q,
+                                       1e-7 * model.rods[0].rest_edge_length.minCoeff(), &ws);
   return (analytic - numeric).norm() / numeric.norm();
 }
 
@@ -125,7 +140,7 @@ omega_bar = 300
   DriveBoundaryConditions(model, h, &q);
   // Dense J from the banded parts and the mobility.
   std::vector<RodFrames> frames;
-  VecX r0, rp, rm;
+  VecX r0;
   Evaluate(model, state, h, q, true, &ws, &frames, &r0);
   const int n = model.num_dofs;
   MatX dense = MatX::Zero(n, n);
@@ -145,21 +160,7 @@ omega_bar = 300
       if (position_dof[a] >= 0 && position_dof[b] >= 0)
         dense(position_dof[a], position_dof[b]) += resistance(a, b) / h;
   // J against finite differences of the whole residual (drag included).
-  MatX numeric(n, n);
-  const double eps = 1e-8;
-  for (int k = 0; k < n; ++k) {
-    VecX qp = q, qm = q;
-    qp(k) += eps;
-    qm(k) -= eps;
-    Evaluate(model, state, h, qp, false, &ws, &frames, &rp);
-    Evaluate(model, state, h, qm, false, &ws, &frames, &rm);
-    numeric.col(k) = (rp - rm) / (2 * eps);
-  }
-  for (const RodModel& rod : model.rods)
-    for (int k : rod.fixed_dofs) {
-      numeric.col(rod.dof_offset + k).setZero();
-      numeric(rod.dof_offset + k, rod.dof_offset + k) = 1.0;
-    }
+  const MatX numeric = NumericJacobian(model, state, h, q, 1e-8, &ws);
   const double jacobian_error = (dense - numeric).norm() / numeric.norm();
   // The Woodbury solve against the dense LU.
   Evaluate(model, state, h, q, true, &ws, &frames, &r0);
