@@ -47,10 +47,15 @@ def buckled(m):
     return m["tip"] > 2.0 * R
 
 
-def sweep(model, nodes, h, omegas, lo, hi, tol):
+def sweep(model, nodes, h, omegas, tol):
     cases = [case(model, w, nodes, h) for w in omegas]
     run_all(cases)
     rows = [(w, measure(c[1])) for w, c in zip(omegas, cases)]
+    buckled_at = [w for w, m in rows if buckled(m)]
+    if not buckled_at:
+        raise RuntimeError(f"{model}: no sweep point buckled; extend the sweep")
+    hi = min(buckled_at)
+    lo = max(w for w, m in rows if w < hi)
     # Bisection on ω̄_b between the largest stable and the smallest buckled sweep point.
     while hi - lo > tol:
         mids = [lo + (hi - lo) / 3.0, lo + 2.0 * (hi - lo) / 3.0]  # two at a time
@@ -69,6 +74,7 @@ def sweep(model, nodes, h, omegas, lo, hi, tol):
     rows.sort(key=lambda r: r[0])
     path = os.path.join(DOCS, f"buckling_{model}_N{nodes}_h{h:g}.csv")
     with open(path, "w") as f:
+        f.write(f"# omega_b in [{lo:.1f}, {hi:.1f}]\n")
         f.write("omega_bar,l_bar_at_t1,tip_axis_distance_max_over_R,propulsive_force_bar,buckled\n")
         for w, m in rows:
             f.write(f"{w},{m['l_bar']:.6f},{m['tip'] / R:.4f},{m['thrust_bar']:.5g},{int(buckled(m))}\n")
@@ -89,9 +95,9 @@ def main():
         nodes = args.nodes or (195 if args.model == "lsbt" else 65)
         if args.model == "rss":
             omegas = [100, 200, 300, 400, 500, 533, 600, 700, 800, 900, 1067]
-            sweep(args.model, nodes, args.h, omegas, 600, 700, 10)
+            sweep(args.model, nodes, args.h, omegas, 20)
         else:
-            sweep(args.model, nodes, args.h, [500, 600, 700, 800], 600, 700, 20)
+            sweep(args.model, nodes, args.h, [500, 600, 700, 800, 900], 20)
     elif args.what == "series":
         cs = [case("rss", w, 65, args.h) for w in (533, 1067)]
         run_all(cs)
