@@ -7,6 +7,7 @@
   buckling.py explicit                             explicit h = 0.2 ms against implicit h = 1 ms
   buckling.py timing                               compute time per simulated second
   buckling.py sense                                the other sense of rotation, and RFT in both
+  buckling.py confirm --around W                   ω̄ = W ± 10 at h = 1 ms (the threshold at the paper's step)
 
 Buckled or not: the helix has lost its shape when the tip leaves the rotation axis. We use the
 largest distance of the last node from the vertical through the clamp over the last 20 % of the
@@ -85,7 +86,8 @@ def sweep(model, nodes, h, omegas, tol):
 def main():
     p = argparse.ArgumentParser()
     p.add_argument("what", choices=["sweep", "series", "convergence", "explicit", "timing",
-                                    "sense"])
+                                    "sense", "confirm"])
+    p.add_argument("--around", type=float, default=0.0)
     p.add_argument("--model", default="rss")
     p.add_argument("--h", type=float, default=1e-2)
     p.add_argument("--nodes", type=int, default=0)
@@ -97,10 +99,12 @@ def main():
             omegas = [100, 200, 300, 400, 500, 533, 600, 700, 800, 900, 1067]
             sweep(args.model, nodes, args.h, omegas, 20)
         else:
-            sweep(args.model, nodes, args.h, [500, 600, 700, 800, 900], 20)
+            sweep(args.model, nodes, args.h, [500, 600, 700, 800], 40)
     elif args.what == "series":
         cs = [case("rss", w, 65, args.h) for w in (533, 1067)]
         run_all(cs)
+    elif args.what == "confirm":
+        run_all([case("rss", args.around + d, 65, 1e-3) for d in (-10.0, 10.0)])
     elif args.what == "sense":
         cs = [case("rss", w, 65, 1e-2, t_end=0.5) for w in (-100, -200, -300, -533)]
         cs += [case("rft", w, 65, 1e-2, t_end=0.5) for w in (-533, 533)]
@@ -112,7 +116,7 @@ def main():
                 f.write(f"{c[2]['fluid.model']},{c[2]['rods.omega_bar']},{m['l_bar']:.5f},"
                         f"{m['tip'] / R:.3f}\n")
     elif args.what == "convergence":
-        cs = [case("rss", w, n, 1e-2) for n in (43, 81) for w in (533, 700, 900)]
+        cs = [case("rss", w, n, 1e-2) for n in (43, 81) for w in (700, 800)]
         cs += [case("rss", 533, 65, h, t_end=0.1, tag="_short") for h in (1e-2, 1e-3, 1e-4)]
         run_all(cs)
     elif args.what == "explicit":
