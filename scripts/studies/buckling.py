@@ -83,10 +83,53 @@ def sweep(model, nodes, h, omegas, tol):
     return lo, hi
 
 
+def plot():
+    """Fig. 5(c1), 5(c2) / C.11(a) from the runs that exist."""
+    import glob
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(1, 3, figsize=(14, 4))
+    for w, color in ((533, "tab:blue"), (1067, "tab:red")):
+        out = case("rss", w, 65, 1e-2)[1]
+        if os.path.exists(os.path.join(out, "timeseries.csv")):
+            ts = timeseries(out)
+            ax[0].plot(ts["t_bar"], ts["rod1_length_bar"], color=color, label=f"ω̄ = {w}")
+            ax[2].plot(ts["t_bar"], ts["rod1_tip_axis_distance"] / R, color=color, label=f"ω̄ = {w}")
+    ax[0].set_xlabel("t̄")
+    ax[0].set_ylabel("l̄ = l / l0")
+    ax[0].legend()
+    ax[2].set_xlabel("t̄")
+    ax[2].set_ylabel("tip distance from the axis / R")
+    ax[2].legend()
+    for path, style, label in ((f"{DOCS}/buckling_rss_N65_h0.01.csv", "o-", "RSS, N = 65"),
+                               (f"{DOCS}/buckling_lsbt_N195_h0.01.csv", "s--", "LSBT, N = 195")):
+        if not os.path.exists(path):
+            continue
+        d = np.genfromtxt(path, delimiter=",", names=True, comments="#")
+        ax[1].plot(d["omega_bar"], d["l_bar_at_t1"], style, label=label, ms=4)
+    for n, style in ((43, "^"), (81, "v")):
+        pts = []
+        for out in glob.glob(os.path.join(OUT, f"rss_N{n}_h0.01_w*")):
+            if out.endswith(".log") or not os.path.exists(os.path.join(out, "summary.json")):
+                continue
+            pts.append((float(out.split("_w")[-1]), measure(out)["l_bar"]))
+        if pts:
+            pts.sort()
+            ax[1].plot(*zip(*pts), style, label=f"RSS, N = {n}", ms=6, mfc="none")
+    ax[1].axvline(675, color="gray", lw=0.8, ls=":", label="paper ω̄_b (RSS) = 675")
+    ax[1].set_xlabel("ω̄")
+    ax[1].set_ylabel("l̄ at t̄ = 1")
+    ax[1].legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(DOCS, "fig5_buckling.png"), dpi=110)
+    log("wrote", os.path.join(DOCS, "fig5_buckling.png"))
+
+
 def main():
     p = argparse.ArgumentParser()
     p.add_argument("what", choices=["sweep", "series", "convergence", "explicit", "timing",
-                                    "sense", "confirm"])
+                                    "sense", "confirm", "plot"])
     p.add_argument("--around", type=float, default=0.0)
     p.add_argument("--model", default="rss")
     p.add_argument("--h", type=float, default=1e-2)
@@ -103,6 +146,8 @@ def main():
     elif args.what == "series":
         cs = [case("rss", w, 65, args.h) for w in (533, 1067)]
         run_all(cs)
+    elif args.what == "plot":
+        plot()
     elif args.what == "confirm":
         run_all([case("rss", args.around + d, 65, 1e-3) for d in (-10.0, 10.0)])
     elif args.what == "sense":
