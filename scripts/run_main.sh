@@ -8,3 +8,4 @@ cmake --preset release
 cmake --build --preset release --target stokesrods
 ./build/release/apps/stokesrods/stokesrods run examples/fig1_bundling.toml "$@"
 /usr/bin/python3 python/plot_snapshots.py out/fig1 --times 0 25 50 75
+/usr/bin/python3 python/plot_flow.py out/fig1
