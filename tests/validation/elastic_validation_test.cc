@@ -191,6 +191,42 @@ TEST(EulerBuckling, FivePercentAboveBucklesFivePercentBelowDoesNot) {
   }
 }
 
+// A straight rod hanging under its own weight: the edge below node j carries the weight of the
+// nodes below it, so with lumped masses the tip drops by exactly ρ g L'²/(2E), L' = (N − 2)Δl the
+// length below the clamped first edge; the clamp load (eq. 25) is the total weight.
+TEST(Gravity, HangingRodStretchesByRhoGLSquaredOver2E) {
+  const Model model = ModelFromToml(R"(
+[run]
+mode = "static"
+[fluid]
+model = "none"
+[contact]
+enabled = false
+[gravity]
+acceleration = [0.0, 0.0, -9.81]
+[solver]
+newton_tolerance = 1e-12
+[[rods]]
+shape = "straight"
+nodes = 41
+axis_length = 0.2
+young_modulus = 1e5
+)");
+  State state = MakeRestState(model);
+  Workspace ws(model);
+  ASSERT_TRUE(SolveStatic(model, &state, &ws).ok);
+  const RodModel& rod = model.rods[0];
+  const double below = (rod.num_nodes() - 2) * rod.rest_edge_length(0);
+  const double expected = 1000.0 * 9.81 * below * below / (2.0 * 1e5);
+  const double drop = -0.2 - Tip(model, state).z();
+  EXPECT_NEAR(drop / expected, 1.0, 1e-3) << drop << " vs " << expected;
+  double weight = 0.0;
+  for (int i = 0; i < rod.num_nodes(); ++i) weight += rod.mass(NodeDof(i)) * 9.81;
+  const ClampLoad clamp = CalcClampLoad(model, state, ws, 0);
+  EXPECT_NEAR(clamp.force.z() / -weight, 1.0, 1e-9);
+  EXPECT_NEAR(clamp.force.head<2>().norm(), 0.0, 1e-12 * weight);
+}
+
 constexpr char kRestHelix[] = R"(
 [run]
 duration = 1.0
