@@ -27,9 +27,10 @@ DOCS = os.path.join(ROOT, "docs", "validation")
 R = 0.01
 
 
-def case(model, omega_bar, nodes, h, t_end=1.0, coupling="implicit", tag=""):
+def case(model, omega_bar, nodes, h, t_end=1.0, coupling="implicit", tag="", extra=None):
     name = f"{model}_N{nodes}_h{h:g}_w{omega_bar:g}{tag}"
-    overrides = {"rods.omega_bar": omega_bar, "rods.nodes": nodes, "fluid.model": model,
+    overrides = dict(extra or {})
+    overrides |= {"rods.omega_bar": omega_bar, "rods.nodes": nodes, "fluid.model": model,
                  "fluid.coupling": coupling, "run.time_step": h, "run.t_bar_end": t_end,
                  "run.output_interval": max(h, 0.5), "run.frames": "false",
                  "run.checkpoint_interval": 50.0}
@@ -129,7 +130,7 @@ def plot():
 def main():
     p = argparse.ArgumentParser()
     p.add_argument("what", choices=["sweep", "series", "convergence", "explicit", "timing",
-                                    "sense", "confirm", "plot"])
+                                    "sense", "confirm", "plot", "diagnose"])
     p.add_argument("--around", type=float, default=0.0)
     p.add_argument("--model", default="rss")
     p.add_argument("--h", type=float, default=1e-2)
@@ -146,6 +147,18 @@ def main():
     elif args.what == "series":
         cs = [case("rss", w, 65, args.h) for w in (533, 1067)]
         run_all(cs)
+    elif args.what == "diagnose":
+        # RSS with ε = √e r0 has the local drag of a cylinder of radius r0 (with 1.02 r0: of
+        # 0.62 r0); does the threshold move down towards the paper's 675?
+        cs = [case("rss", w, 65, 1e-2, tag="_eps1.65", extra={"fluid.regularization": 1.6487})
+              for w in (650, 700)]
+        run_all(cs)
+        with open(os.path.join(DOCS, "buckling_regularization.csv"), "w") as f:
+            f.write("regularization_over_r0,omega_bar,l_bar_at_t1,tip_axis_distance_max_over_R,buckled\n")
+            for c in cs:
+                m = measure(c[1])
+                f.write(f"1.6487,{c[2]['rods.omega_bar']},{m['l_bar']:.5f},{m['tip'] / R:.3f},"
+                        f"{int(buckled(m))}\n")
     elif args.what == "plot":
         plot()
     elif args.what == "confirm":
