@@ -10,6 +10,7 @@ import sys
 import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.ticker  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from stokesrods_frames import nearest_frames, read_frame  # noqa: E402
@@ -24,11 +25,20 @@ def main():
     parser.add_argument("--output", default=None)
     args = parser.parse_args()
     frames = nearest_frames(args.run_dir, args.times)
+    data = [(t, read_frame(path)[0]) for t, path in frames]
+    # One horizontal range per view for all panels, so the snapshots compare at a glance.
+    limits = []
+    for a in (0, 1):
+        lo = min(100 * x[:, a].min() for _, rods in data for x in rods)
+        hi = max(100 * x[:, a].max() for _, rods in data for x in rods)
+        pad = 0.1 * (hi - lo) + 0.5
+        limits.append((lo - pad, hi + pad))
     fig, axes = plt.subplots(2, len(frames), figsize=(2.6 * len(frames), 7.0), squeeze=False)
-    for column, (t, path) in enumerate(frames):
-        rods, _ = read_frame(path)
+    for column, (t, rods) in enumerate(data):
         for row, (a, label) in enumerate([(0, "x [cm]"), (1, "y [cm]")]):
             ax = axes[row][column]
+            ax.set_xlim(*limits[a])
+            ax.xaxis.set_major_locator(matplotlib.ticker.MaxNLocator(4))
             for k, x in enumerate(rods):
                 ax.plot(100 * x[:, a], 100 * x[:, 2], "-", color=COLORS[k % len(COLORS)], lw=2.5,
                         solid_capstyle="round")
