@@ -190,15 +190,17 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
   StepReport report;
   PrepareStep(model, *state, ws);
 
+  // Algorithm 1's guess q_k + h q̇_k, plus ½h² q̈_k once two velocities are known: rods that
+  // turn by a sizeable angle per step move on circles, which the linear guess misses. Contact
+  // rounds after the first start from the previous round's solution.
+  ws->q = state->q + h * state->velocity;
+  if (ws->previous_velocity.size() == state->velocity.size())
+    ws->q += 0.5 * h * (state->velocity - ws->previous_velocity);
+  for (const RodModel& rod : model.rods)
+    for (int k : rod.fixed_dofs) ws->q(rod.dof_offset + k) = state->q(rod.dof_offset + k);
+  DriveBoundaryConditions(model, h, &ws->q);
+
   for (report.contact_rounds = 1;; ++report.contact_rounds) {
-    // Algorithm 1's guess q_k + h q̇_k, plus ½h² q̈_k once two velocities are known: rods that
-    // turn by a sizeable angle per step move on circles, which the linear guess misses.
-    ws->q = state->q + h * state->velocity;
-    if (ws->previous_velocity.size() == state->velocity.size())
-      ws->q += 0.5 * h * (state->velocity - ws->previous_velocity);
-    for (const RodModel& rod : model.rods)
-      for (int k : rod.fixed_dofs) ws->q(rod.dof_offset + k) = state->q(rod.dof_offset + k);
-    DriveBoundaryConditions(model, h, &ws->q);
     const NewtonReport newton = SolveNewton(model, *state, h, ws);
     report.newton_iterations += newton.iterations;
     if (!newton.converged) {
@@ -219,7 +221,7 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
       NewtonCorrection(model, h, -force, ws, dq);  // −J⁻¹(−F) = J⁻¹ F
     };
     report.contact = AddContactForces(model, ws->q, h, respond, &ws->contact_force);
-    if (report.contact.active == 0) break;
+    if (report.contact.active == 0) break;  // report.contact describes the final state
     report.contact_pairs = std::max(report.contact_pairs, report.contact.detected);
     if (report.contact_rounds >= model.newton.max_contact_rounds) {
       report.message = fmt::format(
@@ -230,8 +232,6 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
       return report;
     }
   }
-  if (model.contact) report.contact = MeasureContacts(model, ws->q);
-
   ws->previous_velocity = state->velocity;
   state->velocity = (ws->q - state->q) / h;
   state->q = ws->q;
