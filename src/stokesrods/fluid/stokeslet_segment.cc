@@ -143,16 +143,25 @@ const GaussLegendreRule& Rule(int n) {
 }
 
 // Points for n-point Gauss–Legendre to reach round-off on the integrand of eq. 8. Its nearest
-// singularities are at α = α* ± i d/L (R_α = 0, d² = |r⊥|² + ε²); on z = 2α − 1 ∈ [−1, 1] they lie
-// on the Bernstein ellipse of parameter ρ = |z0 + √(z0² − 1)|, and the error falls like ρ^(−2n):
+// singularities are at α = α* ± i d/L (R_α = 0, d² = |r⊥|² + ε²), at z0 on z = 2α − 1; the error
+// of n points falls like ρ^(−2n), ρ the parameter of the Bernstein ellipse of [−1, 1] through z0:
 // n = ln(1e-16)/(−2 ln ρ), plus two for the algebraic prefactor of the R⁻³ singularity.
-int FarFieldPointCount(double alpha_star, double d_over_length) {
-  const std::complex<double> z0(2.0 * alpha_star - 1.0, 2.0 * d_over_length);
-  std::complex<double> w = z0 + std::sqrt(z0 * z0 - 1.0);
-  if (std::abs(w) < 1.0) w = z0 - std::sqrt(z0 * z0 - 1.0);
-  const double log_rho = std::log(std::abs(w));
-  const int n = static_cast<int>(std::ceil(36.8 / (2.0 * log_rho))) + 2;
-  return std::clamp(n, 3, kFarFieldPoints);
+// z0 lies at distance 2δ from [−1, 1], δ = √(distance from x̂ to the segment² + ε²)/L, and the
+// Bernstein ellipses come closest to the interval at its ends (semi-major axis a = (ρ + 1/ρ)/2 = 1 + 2δ there), so
+// ρ ≥ ρ_min(δ) with ρ_min + 1/ρ_min = 2 + 4δ. The smallest δ for which n points suffice is
+// tabulated once from that bound: never fewer points than the exact rule.
+int FarFieldPointCount(double delta) {
+  static const std::array<double, kFarFieldPoints + 1> kMinDelta = [] {
+    std::array<double, kFarFieldPoints + 1> t{};
+    for (int n = 3; n <= kFarFieldPoints; ++n) {
+      const double rho = std::exp(36.8 / (2.0 * (n - 2)));  // from n = ⌈36.8/(2 ln ρ)⌉ + 2
+      t[static_cast<size_t>(n)] = (rho + 1.0 / rho - 2.0) / 4.0;  // ρ + 1/ρ = 2 + 4δ
+    }
+    return t;
+  }();
+  for (int n = 3; n < kFarFieldPoints; ++n)
+    if (delta >= kMinDelta[static_cast<size_t>(n)]) return n;
+  return kFarFieldPoints;
 }
 
 SegmentMobility FarFieldSegment(const Vec3& xa, const Vec3& v, double length, double eps,
@@ -200,9 +209,8 @@ SegmentMobility StokesletSegment(const Vec3& xa, const Vec3& xb, double regulari
   const double along = alpha_star < 0.0 ? -alpha_star : (alpha_star > 1.0 ? alpha_star - 1.0 : 0.0);
   const double distance2 = r_perp.squaredNorm() + along * along * l2;
   if (distance2 + eps * eps >= l2) {
-    const double d_over_length = std::sqrt((r_perp.squaredNorm() + eps * eps) / l2);
-    return FarFieldSegment(xa, v, length, eps, point,
-                           FarFieldPointCount(alpha_star, d_over_length));
+    const double delta = std::sqrt((distance2 + eps * eps) / l2);
+    return FarFieldSegment(xa, v, length, eps, point, FarFieldPointCount(delta));
   }
 
   const double d = std::sqrt(r_perp.squaredNorm() + eps * eps);
