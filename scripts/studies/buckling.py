@@ -76,10 +76,11 @@ def sweep(model, nodes, h, omegas, tol):
     rows.sort(key=lambda r: r[0])
     path = os.path.join(DOCS, f"buckling_{model}_N{nodes}_h{h:g}.csv")
     with open(path, "w") as f:
-        f.write(f"# omega_b in [{lo:.1f}, {hi:.1f}]\n")
         f.write("omega_bar,l_bar_at_t1,tip_axis_distance_max_over_R,propulsive_force_bar,buckled\n")
         for w, m in rows:
             f.write(f"{w},{m['l_bar']:.6f},{m['tip'] / R:.4f},{m['thrust_bar']:.5g},{int(buckled(m))}\n")
+    with open(path.replace(".csv", "_threshold.txt"), "w") as f:
+        f.write(f"omega_b in [{lo:.1f}, {hi:.1f}] (tip farther than 2R from the axis at t_bar <= 1)\n")
     log(f"{model} N={nodes} h={h}: omega_b in [{lo:.1f}, {hi:.1f}] -> {path}")
     return lo, hi
 
