@@ -57,6 +57,13 @@ def sweep(model, nodes, h, omegas, tol):
     if not buckled_at:
         raise RuntimeError(f"{model}: no sweep point buckled; extend the sweep")
     hi = min(buckled_at)
+    while not any(w < hi for w, _ in rows):  # extend the sweep downwards to a stable point
+        w = min(w for w, _ in rows) - 100
+        c = case(model, w, nodes, h)
+        run_all([c])
+        rows.append((w, measure(c[1])))
+        if buckled(rows[-1][1]):
+            hi = w
     lo = max(w for w, m in rows if w < hi)
     # Bisection on ω̄_b between the largest stable and the smallest buckled sweep point.
     while hi - lo > tol:
