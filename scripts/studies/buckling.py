@@ -151,7 +151,7 @@ def main():
             omegas = [100, 200, 300, 400, 500, 533, 600, 700, 800, 900, 1067]
             sweep(args.model, nodes, args.h, omegas, 20)
         else:
-            sweep(args.model, nodes, args.h, [650, 750], 100)
+            sweep(args.model, nodes, args.h, [650], 50)
     elif args.what == "series":
         cs = [case("rss", w, 65, args.h) for w in (533, 1067)]
         run_all(cs)
