@@ -58,6 +58,18 @@ TEST(Cli, VersionAndHelp) {
   EXPECT_EQ(RunCli("frobnicate").code, 2);
 }
 
+TEST(Cli, ShowConfigPrintsEveryDefaultAndTheDerivedQuantities) {
+  const fs::path out = fs::temp_directory_path() / ("stokesrods_cli_show." + std::to_string(getpid()));
+  const std::string cmd = std::string(STOKESRODS_BINARY) + " show-config " + STOKESRODS_SOURCE_DIR +
+                          "/examples/helix.toml --set rods.omega_bar=1067 > " + out.string();
+  ASSERT_EQ(WEXITSTATUS(std::system(cmd.c_str())), 0);
+  const std::string text = Read(out);
+  fs::remove(out);
+  for (const char* expected : {"regularization = 1.02", "poisson_ratio = 0.5", "omega_bar = 1067",
+                               "\"EI\"", "\"GJ\"", "\"time_scale\"", "\"omega\""})
+    EXPECT_NE(text.find(expected), std::string::npos) << expected << "\n" << text;
+}
+
 TEST(Cli, CantileverWritesTheSpecFiles) {
   const fs::path out = fs::temp_directory_path() / "stokesrods_cli_cantilever";
   fs::remove_all(out);
