@@ -45,6 +45,17 @@ def measure(out, fraction=0.2):
             "thrust_bar": ts["propulsive_force_bar"][-1]}
 
 
+def write_table(name, cases, columns):
+    """docs/validation/NAME: one row per case, the given override keys then l̄ and tip / R."""
+    with open(os.path.join(DOCS, name), "w") as f:
+        f.write(",".join(label for label, _ in columns) +
+                ",l_bar_at_end,tip_axis_distance_max_over_R,buckled\n")
+        for c in cases:
+            m = measure(c[1])
+            keys = ",".join(str(c[2][key]) for _, key in columns)
+            f.write(f"{keys},{m['l_bar']:.5f},{m['tip'] / R:.3f},{int(buckled(m))}\n")
+
+
 def buckled(m):
     return m["tip"] > 2.0 * R
 
@@ -161,12 +172,8 @@ def main():
         cs = [case("rss", w, 65, 1e-2, tag="_eps1.65", extra={"fluid.regularization": 1.6487})
               for w in (650, 700)]
         run_all(cs)
-        with open(os.path.join(DOCS, "buckling_regularization.csv"), "w") as f:
-            f.write("regularization_over_r0,omega_bar,l_bar_at_t1,tip_axis_distance_max_over_R,buckled\n")
-            for c in cs:
-                m = measure(c[1])
-                f.write(f"1.6487,{c[2]['rods.omega_bar']},{m['l_bar']:.5f},{m['tip'] / R:.3f},"
-                        f"{int(buckled(m))}\n")
+        write_table("buckling_regularization.csv", cs,
+                    [("regularization_over_r0", "fluid.regularization"), ("omega_bar", "rods.omega_bar")])
     elif args.what == "plot":
         plot()
     elif args.what == "confirm":
@@ -175,12 +182,7 @@ def main():
         cs = [case("rss", w, 65, 1e-2, t_end=0.5) for w in (-100, -200, -300, -533)]
         cs += [case("rft", w, 65, 1e-2, t_end=0.5) for w in (-533, 533)]
         run_all(cs)
-        with open(os.path.join(DOCS, "rotation_sense.csv"), "w") as f:
-            f.write("model,omega_bar,l_bar_at_t0.5,tip_axis_distance_max_over_R\n")
-            for c in cs:
-                m = measure(c[1])
-                f.write(f"{c[2]['fluid.model']},{c[2]['rods.omega_bar']},{m['l_bar']:.5f},"
-                        f"{m['tip'] / R:.3f}\n")
+        write_table("rotation_sense.csv", cs, [("model", "fluid.model"), ("omega_bar", "rods.omega_bar")])
     elif args.what == "convergence":
         cs = [case("rss", w, n, 1e-2) for n in (43, 81) for w in (700, 800)]
         cs += [case("rss", 533, 65, h, t_end=0.1, tag="_short") for h in (1e-2, 1e-3, 1e-4)]
@@ -194,7 +196,7 @@ def main():
               case("lsbt", 533, 195, 1e-3, t_end=0.01, tag="_timing"),
               case("rss", 533, 65, 1e-2, t_end=0.01, tag="_timing"),
               case("lsbt", 533, 195, 1e-2, t_end=0.01, tag="_timing")]
-        for c in cs:
+        for c in cs:  # one at a time: nothing else on the cores while they are timed
             run_all([c])
 
 

@@ -235,8 +235,7 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
   ws->previous_velocity = state->velocity;
   state->velocity = (ws->q - state->q) / h;
   state->q = ws->q;
-  std::swap(state->rods, ws->frames);
-  ws->frames = state->rods;
+  std::swap(state->rods, ws->frames);  // ws->frames is rewritten by the next Evaluate
   state->time += h;
   ++state->step;
   ++ws->factors_age;
@@ -257,7 +256,6 @@ StepReport SolveStatic(const Model& model, State* state, Workspace* ws) {
       reached = ws->load_factor;
       state->q = ws->q;
       std::swap(state->rods, ws->frames);
-      ws->frames = state->rods;
       increment = std::min(2.0 * increment, 1.0);
       continue;
     }
