@@ -179,6 +179,20 @@ SegmentMobility FarFieldSegment(const Vec3& xa, const Vec3& v, double length, do
 
 }  // namespace
 
+SegmentMobility StokesletSegmentGauss(const Vec3& xa, const Vec3& xb, double regularization,
+                                      const Vec3& point, int n) {
+  SR_ASSERT(n >= 1 && n <= kFarFieldPoints, "Gauss rule size out of range");
+  const Vec3 v = xb - xa;
+  return FarFieldSegment(xa, v, v.norm(), regularization, point, n);
+}
+
+void GaussLegendreRule01(int n, const double** nodes, const double** weights) {
+  SR_ASSERT(n >= 1 && n <= kFarFieldPoints, "Gauss rule size out of range");
+  const GaussLegendreRule& rule = Rule(n);
+  *nodes = rule.node.data();
+  *weights = rule.weight.data();
+}
+
 Mat3 RegularizedStokesletMatrix(const Vec3& r, double regularization) {
   const double eps2 = regularization * regularization;
   const double big_r2 = r.squaredNorm() + eps2;

@@ -38,6 +38,14 @@ Mat3 StokesletMatrix(const Vec3& r);
 SegmentMobility StokesletSegment(const Vec3& xa, const Vec3& xb, double regularization,
                                  const Vec3& point);
 
+/// A_a, A_b of eq. 8 by an n-point Gauss–Legendre rule (1 ≤ n ≤ 20): exact to rounding only far
+/// from the segment (see StokesletSegment); the far field of the matrix-free mobility.
+SegmentMobility StokesletSegmentGauss(const Vec3& xa, const Vec3& xb, double regularization,
+                                      const Vec3& point, int n);
+
+/// Nodes (on [0, 1]) and weights (summing to 1) of the n-point Gauss–Legendre rule, 1 ≤ n ≤ 20.
+void GaussLegendreRule01(int n, const double** nodes, const double** weights);
+
 /// Reference for the tests: eq. 8 by adaptive Gauss–Kronrod (7, 15) quadrature, bisecting until
 /// the Kronrod–Gauss difference of every interval is below `relative_tolerance` × |A| (Frobenius)
 /// × the interval's length. The interval is first split at the projection α* of x̂.

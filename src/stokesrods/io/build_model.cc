@@ -131,6 +131,10 @@ Model BuildModel(const Config& config) {
   model.fluid.regularization = config.fluid.regularization;
   model.coupling =
       config.fluid.coupling == "explicit" ? FluidCoupling::kExplicit : FluidCoupling::kImplicit;
+  model.hydro.solver =
+      config.fluid.solver == "direct" ? HydroSolver::kDirect : HydroSolver::kKrylov;
+  model.hydro.krylov_tolerance = config.fluid.krylov_tolerance;
+  model.hydro.mobility.tolerance = config.fluid.far_field_tolerance;
   model.contact = config.contact.enabled;
   model.gravity = config.gravity.acceleration;
   model.damping = config.solver.damping;
@@ -168,12 +172,27 @@ Model BuildModel(const Config& config) {
     model.rods.push_back(std::move(rod));
   }
   FinalizeLayout(&model);
+  // "auto": the dense 𝕄 (3M × 3M) while it is small; above 600 nodes (a 14 MB matrix whose
+  // assembly and LU cost more per step than the matrix-free products) the matrix-free operator.
+  const bool matrix_free =
+      config.fluid.mobility == "matrix_free" ||
+      (config.fluid.mobility == "auto" && model.fluid.model == FluidModel::kRss &&
+       model.num_nodes > 600 && config.fluid.solver != "direct");
+  model.hydro.mobility.kind = matrix_free ? MobilityKind::kMatrixFree : MobilityKind::kDense;
 
   CheckFluidModel(config, &model);
 
   // Rods overlapping at the start.
+  std::vector<Eigen::AlignedBox3d> boxes;
+  for (const RodModel& rod : model.rods) {
+    Eigen::AlignedBox3d box;
+    for (int i = 0; i < rod.num_nodes(); ++i) box.extend(Vec3(rod.rest_positions.col(i)));
+    boxes.push_back(box);
+  }
   for (std::size_t a = 0; a < model.rods.size(); ++a)
     for (std::size_t b = a + 1; b < model.rods.size(); ++b) {
+      const double contact_distance = model.rods[a].radius + model.rods[b].radius;
+      if (boxes[a].exteriorDistance(boxes[b]) >= contact_distance) continue;
       Model pair;
       pair.rods = {model.rods[a], model.rods[b]};
       FinalizeLayout(&pair);

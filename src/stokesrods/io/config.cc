@@ -35,6 +35,10 @@ void VisitFields(FluidConfig& c, V& v) {
   v("viscosity", c.viscosity);
   v("regularization", c.regularization);
   v("coupling", c.coupling);
+  v("mobility", c.mobility);
+  v("far_field_tolerance", c.far_field_tolerance);
+  v("solver", c.solver);
+  v("krylov_tolerance", c.krylov_tolerance);
 }
 template <class V>
 void VisitFields(ContactConfig& c, V& v) {

@@ -107,6 +107,20 @@ void ValidateConfig(Config* config) {
   c.OneOf("fluid.coupling", config->fluid.coupling, {"implicit", "explicit"});
   c.Positive("fluid.viscosity", config->fluid.viscosity);
   c.Positive("fluid.regularization", config->fluid.regularization);
+  c.OneOf("fluid.mobility", config->fluid.mobility, {"auto", "dense", "matrix_free"});
+  if (config->fluid.mobility == "matrix_free" && config->fluid.model != "rss")
+    throw ConfigError(c.file, "fluid.mobility",
+                      "\"matrix_free\" is implemented for fluid.model = \"rss\" only");
+  c.OneOf("fluid.solver", config->fluid.solver, {"krylov", "direct"});
+  if (config->fluid.solver == "direct" && config->fluid.mobility == "matrix_free")
+    throw ConfigError(c.file, "fluid.solver",
+                      "\"direct\" needs the dense mobility (fluid.mobility = \"dense\")");
+  c.Positive("fluid.far_field_tolerance", config->fluid.far_field_tolerance);
+  c.Positive("fluid.krylov_tolerance", config->fluid.krylov_tolerance);
+  if (config->fluid.far_field_tolerance >= 1e-2)
+    throw ConfigError(c.file, "fluid.far_field_tolerance", "must be below 1e-2");
+  if (config->fluid.krylov_tolerance >= 1e-2)
+    throw ConfigError(c.file, "fluid.krylov_tolerance", "must be below 1e-2");
   c.Positive("contact.tolerance", config->contact.tolerance);
   c.Range("contact.max_rounds", config->contact.max_rounds, 1, 100000);
   c.Finite("gravity.acceleration", config->gravity.acceleration);

@@ -53,7 +53,7 @@ class Observer {
     last_row_ = CalcTimeseriesRow(model_, state, ws, report);
     csv_.WriteRow(last_row_);
     if (frames_) {
-      VecX hydro = ws.nonlocal_fluid ? ws.hydro.nodal_force() : VecX();
+      VecX hydro = ws.nonlocal_fluid ? ws.hydro_force : VecX();
       VecX contact = VecX::Zero(3 * model_.num_nodes);
       for (const RodModel& rod : model_.rods)
         for (int i = 0; i < rod.num_nodes(); ++i)

@@ -1,56 +1,103 @@
 // Nonlocal hydrodynamics (RSS, LSBT) inside the implicit Euler step (paper eqs. 16, 21, 22).
 //
-// The mobility 𝕄 (U = 𝕄 F, fluid/hydrodynamics.h) is assembled at q(t_k) and kept for the step.
-//   explicit (paper Algorithm 1): F^h = −𝕄⁻¹ U(t_k), a constant force during the Newton solve;
-//   implicit (default):           F^h = −𝕄⁻¹ U(t_{k+1}), U = (x − x(t_k))/h, whose Jacobian
-//                                 𝕄⁻¹/h is dense over all nodes of all rods.
-// The implicit Newton system J δ = r with J = B + Sᵀ 𝕄⁻¹ S / h (B the banded per-rod part, S the
-// selection of free position DOFs) is solved by the Woodbury identity
-//   J⁻¹ r = B⁻¹ r − X (h 𝕄 + S X)⁻¹ S B⁻¹ r,   X = B⁻¹ Sᵀ,
-// which needs one dense LU of size 3M per Newton iteration instead of one of size 4M, and no
-// inverse of 𝕄.
+// The mobility 𝕄 (U = 𝕄 F, fluid/mobility_operator.h) is taken at q(t_k) and kept for the step.
+//   explicit (paper Algorithm 1): the drag f = −𝕄⁻¹ U(t_k), a constant force during the Newton solve;
+//   implicit (default):           the drag f on the rods is an unknown beside q, with
+//                                 r_q = M(q − q_k − h v_k)/h² − F(q) − Sᵀ f = 0   (momentum)
+//                                 r_u = S(q − q_k)/h + 𝕄 f = 0                   (no slip)
+//                                 S the selection of the free position DOFs.
+// Newton's matrix [B  −Sᵀ; S/h  𝕄] (B the banded per-rod part) is solved by eliminating δq:
+//   y = −B⁻¹ r_q,  X = B⁻¹ Sᵀ,  C δf = −(h r_u + S y),  C = h 𝕄 + S X,  δq = y + X δf,
+// C of size 3M and never 𝕄⁻¹. The capacitance C is solved
+//   direct: by a dense LU of C at the current 𝕄 (the reference, refactorized whenever 𝕄 or B is),
+//   krylov: by GMRES with products h 𝕄 v + S X v (𝕄 matrix-free or dense) and a preconditioner
+//           kept across steps: the LU of the whole C (dense 𝕄) or of its per-rod diagonal blocks
+//           h 𝕄_kk + S_k X_k (matrix-free), rebuilt with the Newton factors or when GMRES slows.
+// Since r_u is linear in (q, f), after a full Newton step it is the GMRES residual / h; along a
+// damped step it changes linearly, so line-search trials need no product with 𝕄.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include <Eigen/LU>
 
+#include "stokesrods/fluid/mobility_operator.h"
 #include "stokesrods/sim/forces.h"
 #include "stokesrods/sim/model.h"
 #include "stokesrods/solver/banded_matrix.h"
 
 namespace stokesrods {
 
+struct HydroSolveReport {
+  bool ok = true;
+  int krylov_iterations = 0;   ///< products with C (0 for the direct solve)
+  double relative_residual = 0.0;
+};
+
 class HydroCoupling {
  public:
-  /// Assembles and factorizes 𝕄 at q_start; for the explicit coupling also F^h(v_start).
-  void Prepare(const Model& model, const VecX& q_start, const VecX& v_start);
+  /// The mobility operator and solver for the model (model.hydro_solver).
+  void Init(const Model& model);
 
-  /// Adds F^h at the trial DOFs q into the global `force`.
-  void AddTo(const Model& model, const StepContext& ctx, const VecX& q, VecX* force);
+  /// Takes 𝕄 at q_start; for the explicit coupling also solves for the drag of v_start.
+  HydroSolveReport Prepare(const Model& model, const VecX& q_start, const VecX& v_start);
 
-  /// Factorizes J = B + Sᵀ 𝕄⁻¹ S / h (implicit coupling), `jacobian` the unfactorized per-rod
-  /// banded parts B (fixed DOFs already identity rows; factorized in place). False if singular.
+  /// The explicit coupling's constant drag on the nodes (3M) of the step.
+  const VecX& explicit_force() const { return explicit_force_; }
+
+  /// force += Sᵀ f: the nodal forces f (3M) on the rods' position DOFs.
+  static void AddNodalForce(const Model& model, const VecX& f, VecX* force);
+
+  /// r_u = S(q − q_start)/h + 𝕄 f (3M) [m/s].
+  void VelocityResidual(const Model& model, const VecX& q, const VecX& q_start, double h,
+                        const VecX& f, VecX* r_u) const;
+
+  /// Builds X and the capacitance's factors (direct) or preconditioner (krylov) from the
+  /// unfactorized banded parts B in `jacobian` (fixed DOFs identity rows; factorized in place).
+  /// False if B or C is singular.
   bool FactorizeNewtonSystem(const Model& model, double h, std::vector<BandedMatrix>* jacobian);
-  /// Solves J δ = rhs in place with the factors of the last FactorizeNewtonSystem.
-  void SolveNewtonSystem(const Model& model, const std::vector<BandedMatrix>& jacobian,
-                         VecX* rhs);
 
-  /// Nodal hydrodynamic forces on the rods (3M) at the last AddTo [N].
-  const VecX& nodal_force() const { return nodal_force_; }
-  const MatX& mobility() const { return mobility_; }
+  /// Solves [B −Sᵀ; S/h 𝕄][δq; δf] = −[r_q; r_u] with the factors of FactorizeNewtonSystem, and
+  /// gives du = S δq/h + 𝕄 δf, the change of r_u along (δq, δf). The Krylov solve stops at
+  /// model.hydro.krylov_tolerance relative to its right-hand side, or once the no-slip residual
+  /// it leaves, |r_u| after the step, is below `velocity_tolerance` [m/s] (inexact Newton: no
+  /// need to solve far below what the Newton test asks).
+  HydroSolveReport SolveNewtonSystem(const Model& model, const std::vector<BandedMatrix>& jacobian,
+                                     double h, const VecX& r_q, const VecX& r_u, VecX* dq,
+                                     VecX* df, VecX* du, double velocity_tolerance = 0.0);
+
+  /// True when the factors must be rebuilt: the direct solve after 𝕄 changed, or a Krylov
+  /// preconditioner gone stale (GMRES needed clearly more iterations than right after it was
+  /// built). The integrator then rebuilds the Newton factors.
+  bool wants_refresh() const { return wants_refresh_ || (!krylov_ && mobility_changed_); }
+
+  const MobilityOperator& mobility() const { return *mobility_; }
+  long krylov_iterations() const { return krylov_total_; }  ///< over the whole run
 
  private:
-  MatX mobility_;                    ///< 𝕄 at q(t_k), 3M × 3M
-  Eigen::PartialPivLU<MatX> lu_;     ///< of 𝕄
+  void ApplyCapacitance(const Model& model, double h, const VecX& v, VecX* out) const;
+  void Precondition(const VecX& v, VecX* out) const;
+
+  std::unique_ptr<MobilityOperator> mobility_;
+  std::vector<Matrix3X> positions_;  ///< at the last Prepare (the operator points into them)
+  bool krylov_ = false;
   bool explicit_ = false;
-  VecX explicit_force_;              ///< 3M, explicit coupling
-  VecX nodal_force_;                 ///< 3M, last evaluated F^h
-  // Scratch of the Woodbury solve.
-  std::vector<MatX> x_blocks_;       ///< X_k = B_k⁻¹ S_kᵀ per rod (n_k × 3N_k)
-  MatX capacitance_;                 ///< h 𝕄 + S X
+  bool mobility_changed_ = true;   ///< 𝕄 was updated since the capacitance was factorized
+  VecX explicit_force_;            ///< 3M
+  std::vector<MatX> x_blocks_;     ///< X_k = B_k⁻¹ S_kᵀ per rod (n_k × 3N_k)
+  std::vector<MatX> sx_blocks_;    ///< S_k X_k (3N_k × 3N_k)
+  // Direct: the LU of C; krylov: the preconditioner (the LU of C, or of its diagonal blocks).
   Eigen::PartialPivLU<MatX> capacitance_lu_;
-  VecX velocity_;                    ///< 3M scratch
+  std::vector<Eigen::PartialPivLU<MatX>> block_lu_;
+  bool block_preconditioner_ = false;
+  int iterations_after_refresh_ = -1;
+  bool wants_refresh_ = false;
+  long krylov_total_ = 0;
+  // The explicit coupling's solve with a matrix-free 𝕄: block LU of the self-mobilities.
+  std::vector<Eigen::PartialPivLU<MatX>> mobility_block_lu_;
+  int mobility_blocks_age_ = 0;
+  mutable VecX scratch_;
 };
 
 /// Gathers the node velocities (x − x_start)/h of all rods into a 3M vector.

@@ -16,6 +16,10 @@ Workspace::Workspace(const Model& model) : local_forces(MakeLocalForces(model)) 
   const int n = model.num_dofs;
   q = q_try = force = residual = residual_try = delta = simplified = contact_force = VecX::Zero(n);
   for (const RodModel& rod : model.rods) jacobian.emplace_back(rod.num_dofs(), 10);
+  if (nonlocal_fluid) {
+    hydro.Init(model);
+    hydro_force = hydro_force_try = VecX::Zero(3 * model.num_nodes);
+  }
 }
 
 void DriveBoundaryConditions(const Model& model, double h, VecX* q) {
@@ -37,6 +41,18 @@ double ResidualNorm(const Model& model, const VecX& r) {
   return norm;
 }
 
+// The no-slip residual r_u [m/s] as a force: times the drag of a node's length of rod, 4πμ Λ_i
+// (the order of a slender rod's resistance per unit length), ∞-norm [N].
+double VelocityResidualNorm(const Model& model, const VecX& r_u) {
+  double norm = 0.0;
+  const double drag = 4.0 * kPi * model.fluid.viscosity;
+  for (const RodModel& rod : model.rods)
+    for (int i = 0; i < rod.num_nodes(); ++i)
+      norm = std::max(norm, drag * rod.rest_voronoi_length(i) *
+                                r_u.segment<3>(3 * (rod.node_offset + i)).cwiseAbs().maxCoeff());
+  return norm;
+}
+
 // The residual that round-off alone leaves: a position known to ε|x| changes a stretching force
 // by EA ε |x| / |ē|; a few ulps of that summed over a node's stencils [N].
 double RoundOffFloor(const Model& model, const VecX& q) {
@@ -51,8 +67,9 @@ double RoundOffFloor(const Model& model, const VecX& q) {
 
 }  // namespace
 
-void Evaluate(const Model& model, const State& start, double h, const VecX& q, bool with_jacobian,
-              Workspace* ws, std::vector<RodFrames>* frames, VecX* residual) {
+void Evaluate(const Model& model, const State& start, double h, const VecX& q,
+              const VecX& hydro_force, bool with_jacobian, Workspace* ws,
+              std::vector<RodFrames>* frames, VecX* residual) {
   TransportFrames(model, q, start.rods, frames);
   ws->force.setZero();
   std::vector<BandedMatrix>* jac = with_jacobian ? &ws->jacobian : nullptr;
@@ -62,7 +79,7 @@ void Evaluate(const Model& model, const State& start, double h, const VecX& q, b
   }
   const StepContext ctx{&start.q, h, ws->load_factor};
   for (const auto& f : ws->local_forces) f->AddTo(model, ctx, q, &ws->force, jac);
-  if (h > 0.0 && ws->nonlocal_fluid) ws->hydro.AddTo(model, ctx, q, &ws->force);
+  if (h > 0.0 && ws->nonlocal_fluid) HydroCoupling::AddNodalForce(model, hydro_force, &ws->force);
   if (h > 0.0) ws->force += ws->contact_force;
 
   *residual = -ws->force;
@@ -83,28 +100,34 @@ void Evaluate(const Model& model, const State& start, double h, const VecX& q, b
 
 namespace {
 
-bool UsesWoodbury(const Model& model, double h, const Workspace& ws) {
+// The implicit nonlocal drag: f is an unknown beside q (sim/hydro_coupling.h).
+bool UsesSaddle(const Model& model, double h, const Workspace& ws) {
   return h > 0.0 && ws.nonlocal_fluid && model.coupling == FluidCoupling::kImplicit;
 }
 
 // Factorizes the Newton matrix assembled in ws->jacobian (in place).
 bool FactorizeJacobian(const Model& model, double h, Workspace* ws) {
-  if (UsesWoodbury(model, h, *ws)) return ws->hydro.FactorizeNewtonSystem(model, h, &ws->jacobian);
+  if (UsesSaddle(model, h, *ws)) return ws->hydro.FactorizeNewtonSystem(model, h, &ws->jacobian);
   for (BandedMatrix& b : ws->jacobian)
     if (!b.Factorize()) return false;
   return true;
 }
 
-// out = −J⁻¹ r with the current factors.
-void NewtonCorrection(const Model& model, double h, const VecX& residual, Workspace* ws,
-                      VecX* out) {
-  *out = -residual;
-  if (UsesWoodbury(model, h, *ws)) {
-    ws->hydro.SolveNewtonSystem(model, ws->jacobian, out);
-    return;
+// The Newton correction with the current factors: dq = −J⁻¹ r for the banded problem; with the
+// implicit nonlocal drag, (dq, df) solve the saddle system for (r, r_u) and du is the change of
+// r_u along them. Returns the Krylov iterations it took.
+int NewtonCorrection(const Model& model, double h, const VecX& residual, const VecX& r_u,
+                     Workspace* ws, VecX* dq, VecX* df, VecX* du,
+                     double velocity_tolerance = 0.0) {
+  if (UsesSaddle(model, h, *ws)) {
+    const HydroSolveReport report = ws->hydro.SolveNewtonSystem(
+        model, ws->jacobian, h, residual, r_u, dq, df, du, velocity_tolerance);
+    return report.krylov_iterations;
   }
+  *dq = -residual;
   for (std::size_t r = 0; r < model.rods.size(); ++r)
-    ws->jacobian[r].Solve(out->data() + model.rods[r].dof_offset, 1);
+    ws->jacobian[r].Solve(dq->data() + model.rods[r].dof_offset, 1);
+  return 0;
 }
 
 // Size of a correction in metres: positions as they are, twist angles times their edge length.
@@ -128,14 +151,23 @@ double CorrectionNorm(const Model& model, const VecX& delta) {
 // or when one iteration reduces the correction by less than a factor 4.
 NewtonReport SolveNewton(const Model& model, const State& start, double h, Workspace* ws) {
   NewtonReport report;
+  const bool saddle = UsesSaddle(model, h, *ws);
   const double step_tolerance = 1e-10 * model.length_scale;
   // Old factors are worth keeping while they converge a step in a few iterations; a step that
   // needed more (a rod turning fast, a contact) rebuilds them at the start of the next.
   bool fresh = !ws->factors_valid || ws->factors_h != h ||
-               ws->factors_age >= model.newton.jacobian_max_age || ws->last_iterations > 3;
-  Evaluate(model, start, h, ws->q, fresh, ws, &ws->frames, &ws->residual);
+               ws->factors_age >= model.newton.jacobian_max_age || ws->last_iterations > 3 ||
+               (saddle && ws->hydro.wants_refresh());
+  Evaluate(model, start, h, ws->q, ws->hydro_force, fresh, ws, &ws->frames, &ws->residual);
+  if (saddle)
+    ws->hydro.VelocityResidual(model, ws->q, start.q, h, ws->hydro_force, &ws->velocity_residual);
+  auto norm_of = [&](const VecX& r, const VecX& r_u) {
+    return saddle ? std::max(ResidualNorm(model, r), VelocityResidualNorm(model, r_u))
+                  : ResidualNorm(model, r);
+  };
   bool have_jacobian = fresh;
-  double norm = ResidualNorm(model, ws->residual);
+  bool have_correction = false;  // ws->delta already holds the correction at ws->q
+  double norm = norm_of(ws->residual, ws->velocity_residual);
   bool small_correction = false;
   for (report.iterations = 0;; ++report.iterations) {
     // The force scale: the characteristic bending force or the applied forces, if larger; never
@@ -149,31 +181,56 @@ NewtonReport SolveNewton(const Model& model, const State& start, double h, Works
       return report;
     }
     if (report.iterations == model.newton.max_iterations) return report;
+    // The no-slip residual a Krylov solve may leave: a tenth of the tolerance, as a velocity
+    // through the largest node drag 4πμΛ (VelocityResidualNorm).
+    const double velocity_tolerance =
+        0.1 * report.tolerance / (4.0 * kPi * model.fluid.viscosity * model.max_voronoi_length);
     if (fresh) {
-      if (!have_jacobian) Evaluate(model, start, h, ws->q, true, ws, &ws->frames, &ws->residual);
+      if (!have_jacobian)
+        Evaluate(model, start, h, ws->q, ws->hydro_force, true, ws, &ws->frames, &ws->residual);
       ws->factors_valid = FactorizeJacobian(model, h, ws);
       ws->factors_h = h;
       ws->factors_age = 0;
       if (!ws->factors_valid) return report;
+      have_correction = false;
     }
-    NewtonCorrection(model, h, ws->residual, ws, &ws->delta);
+    if (!have_correction)
+      report.krylov_iterations += NewtonCorrection(model, h, ws->residual, ws->velocity_residual,
+                                                   ws, &ws->delta, &ws->hydro_delta,
+                                                   &ws->hydro_rate, velocity_tolerance);
     const double delta_norm = CorrectionNorm(model, ws->delta);
     double alpha = 1.0, simplified_norm = 0.0;
     for (int halving = 0;; ++halving, alpha *= 0.5) {
       ws->q_try = ws->q + alpha * ws->delta;
-      Evaluate(model, start, h, ws->q_try, false, ws, &ws->frames_try, &ws->residual_try);
-      NewtonCorrection(model, h, ws->residual_try, ws, &ws->simplified);
+      if (saddle) {
+        ws->hydro_force_try = ws->hydro_force + alpha * ws->hydro_delta;
+        ws->velocity_residual_try = ws->velocity_residual + alpha * ws->hydro_rate;
+      }
+      Evaluate(model, start, h, ws->q_try, saddle ? ws->hydro_force_try : ws->hydro_force, false,
+               ws, &ws->frames_try, &ws->residual_try);
+      report.krylov_iterations += NewtonCorrection(
+          model, h, ws->residual_try, ws->velocity_residual_try, ws, &ws->simplified,
+          &ws->simplified_hydro_delta, &ws->simplified_hydro_rate, velocity_tolerance);
       simplified_norm = CorrectionNorm(model, ws->simplified);
       if (simplified_norm <= (1.0 - 0.25 * alpha) * delta_norm || halving == 10) break;
     }
     std::swap(ws->q, ws->q_try);
     std::swap(ws->frames, ws->frames_try);
     std::swap(ws->residual, ws->residual_try);
-    norm = ResidualNorm(model, ws->residual);
+    if (saddle) {
+      std::swap(ws->hydro_force, ws->hydro_force_try);
+      std::swap(ws->velocity_residual, ws->velocity_residual_try);
+    }
+    norm = norm_of(ws->residual, ws->velocity_residual);
     small_correction = simplified_norm <= step_tolerance;
-    // Poor contraction (or a damped step): rebuild the factors at the new iterate.
+    // Poor contraction (or a damped step): rebuild the factors at the new iterate. Otherwise the
+    // simplified correction, made with the same factors at the accepted iterate, is the next one.
     have_jacobian = false;
     fresh = simplified_norm > 0.25 * delta_norm || alpha < 1.0;
+    std::swap(ws->delta, ws->simplified);
+    std::swap(ws->hydro_delta, ws->simplified_hydro_delta);
+    std::swap(ws->hydro_rate, ws->simplified_hydro_rate);
+    have_correction = true;
   }
 }
 
@@ -181,7 +238,10 @@ NewtonReport SolveNewton(const Model& model, const State& start, double h, Works
 
 void PrepareStep(const Model& model, const State& start, Workspace* ws) {
   for (const auto& f : ws->local_forces) f->Prepare(model, start.q);
-  if (ws->nonlocal_fluid) ws->hydro.Prepare(model, start.q, start.velocity);
+  if (ws->nonlocal_fluid) {
+    ws->hydro.Prepare(model, start.q, start.velocity);
+    if (model.coupling == FluidCoupling::kExplicit) ws->hydro_force = ws->hydro.explicit_force();
+  }
   ws->contact_force.setZero();
   ws->load_factor = 1.0;
 }
@@ -203,6 +263,7 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
   for (report.contact_rounds = 1;; ++report.contact_rounds) {
     const NewtonReport newton = SolveNewton(model, *state, h, ws);
     report.newton_iterations += newton.iterations;
+    report.krylov_iterations += newton.krylov_iterations;
     if (!newton.converged) {
       report.message = fmt::format(
           "Newton did not converge at t = {:.6g} s: residual {:.3e} N > tolerance {:.3e} N after "
@@ -212,13 +273,15 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
     }
     if (!model.contact) break;
     if (!ws->factors_valid || ws->factors_h != h) {  // the response needs the Newton matrix
-      Evaluate(model, *state, h, ws->q, true, ws, &ws->frames, &ws->residual);
+      Evaluate(model, *state, h, ws->q, ws->hydro_force, true, ws, &ws->frames, &ws->residual);
       ws->factors_valid = FactorizeJacobian(model, h, ws);
       ws->factors_h = h;
       ws->factors_age = 0;
     }
+    const VecX no_slip = VecX::Zero(ws->nonlocal_fluid ? 3 * model.num_nodes : 0);
     const LinearResponse respond = [&](const VecX& force, VecX* dq) {
-      NewtonCorrection(model, h, -force, ws, dq);  // −J⁻¹(−F) = J⁻¹ F
+      VecX df, du;  // −J⁻¹(−F) = J⁻¹ F, the drag responding with the rods
+      report.krylov_iterations += NewtonCorrection(model, h, -force, no_slip, ws, dq, &df, &du);
     };
     report.contact = AddContactForces(model, ws->q, h, respond, &ws->contact_force);
     if (report.contact.active == 0) break;  // report.contact describes the final state

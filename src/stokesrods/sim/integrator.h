@@ -25,6 +25,7 @@ struct NewtonReport {
   int iterations = 0;
   double residual = 0.0;   ///< weighted ∞-norm of r at the last iterate [N]
   double tolerance = 0.0;  ///< what it had to reach [N]
+  int krylov_iterations = 0;
 };
 
 struct StepReport {
@@ -33,6 +34,7 @@ struct StepReport {
   int newton_iterations = 0; ///< summed over contact rounds
   int contact_rounds = 0;
   int contact_pairs = 0;     ///< most pairs that received contact forces in one round
+  int krylov_iterations = 0; ///< GMRES products with the capacitance (implicit nonlocal drag)
   ContactSummary contact;    ///< at the end of the step
 };
 
@@ -44,6 +46,11 @@ struct Workspace {
   std::vector<std::unique_ptr<ExternalForce>> local_forces;
   HydroCoupling hydro;
   bool nonlocal_fluid = false;   ///< RSS or LSBT
+  /// The drag on the nodes (3M) [N]: implicit coupling, an unknown of the Newton iterate beside q
+  /// (kept from step to step as the first guess); explicit, the constant of the step.
+  VecX hydro_force, hydro_force_try;
+  VecX velocity_residual, velocity_residual_try;  ///< r_u at the iterate and at the trial
+  VecX hydro_delta, hydro_rate, simplified_hydro_delta, simplified_hydro_rate;  ///< δf, du
   VecX q;                        ///< the Newton iterate q(t_{k+1})
   VecX q_try;                    ///< line-search trial
   std::vector<RodFrames> frames; ///< frames transported to q
@@ -65,12 +72,14 @@ struct Workspace {
 /// the explicit drag), the contact force reset. Step calls it; Evaluate needs it first.
 void PrepareStep(const Model& model, const State& start, Workspace* ws);
 
-/// The residual r(q) of the step from `start` (h = 0: the static problem, without inertia and
-/// velocity-dependent forces) with the frames transported to q into `frames`, and, when
-/// `with_jacobian`, the per-rod banded Jacobians ∂r/∂q in ws->jacobian (nonlocal implicit drag
-/// excluded: it enters through HydroCoupling::SolveNewtonSystem). Fixed DOFs: r = 0, identity rows.
-void Evaluate(const Model& model, const State& start, double h, const VecX& q, bool with_jacobian,
-              Workspace* ws, std::vector<RodFrames>* frames, VecX* residual);
+/// The residual r_q(q, f) of the step from `start` (h = 0: the static problem, without inertia
+/// and velocity-dependent forces) with the frames transported to q into `frames`, and, when
+/// `with_jacobian`, the per-rod banded Jacobians ∂r_q/∂q in ws->jacobian. `hydro_force` is the
+/// nodal drag f (3M) of a nonlocal fluid model (ignored otherwise); with the implicit coupling it
+/// is an unknown beside q, its equation r_u = 0 is HydroCoupling's. Fixed DOFs: r = 0, identity rows.
+void Evaluate(const Model& model, const State& start, double h, const VecX& q,
+              const VecX& hydro_force, bool with_jacobian, Workspace* ws,
+              std::vector<RodFrames>* frames, VecX* residual);
 
 /// The drive of the boundary conditions: the target values of the fixed DOFs at t_k + h
 /// (θ0 ← θ0 + h ω' for driven rods, everything else held).

@@ -62,6 +62,8 @@ void FinalizeLayout(Model* model) {
     const double length = rod.rest_edge_length.sum();
     force_scale = std::max(force_scale, rod.bending_stiffness / (length * length));
     model->length_scale = std::max(model->length_scale, length);
+    model->max_voronoi_length =
+        std::max(model->max_voronoi_length, rod.rest_voronoi_length.maxCoeff());
   }
   model->num_dofs = dofs;
   model->num_nodes = nodes;

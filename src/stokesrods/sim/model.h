@@ -8,6 +8,7 @@
 
 #include "stokesrods/common/types.h"
 #include "stokesrods/fluid/hydrodynamics.h"
+#include "stokesrods/fluid/mobility_operator.h"
 
 namespace stokesrods {
 
@@ -70,16 +71,27 @@ struct NewtonOptions {
   int jacobian_max_age = 20;
 };
 
+/// How the capacitance C = h𝕄 + S X of the implicit coupling is solved (sim/hydro_coupling.h).
+enum class HydroSolver { kDirect, kKrylov };
+
+struct HydroOptions {
+  MobilityOptions mobility;                    ///< dense or matrix-free 𝕄
+  HydroSolver solver = HydroSolver::kKrylov;
+  double krylov_tolerance = 1e-10;             ///< GMRES: |b − C x| ≤ this × |b|  [–]
+};
+
 struct Model {
   std::vector<RodModel> rods;
   FluidParams fluid;                 ///< fluid.model == kNone: no hydrodynamics
   FluidCoupling coupling = FluidCoupling::kImplicit;
+  HydroOptions hydro;
   bool contact = false;
   Vec3 gravity = Vec3::Zero();       ///< [m/s²]
   double damping = 0.0;              ///< local viscous damping per unit length [Pa·s] (validation)
   NewtonOptions newton;
   double force_scale = 0.0;          ///< characteristic force max EI/L² over rods [N]
   double length_scale = 0.0;         ///< longest rod arc length [m]
+  double max_voronoi_length = 0.0;   ///< largest rest Voronoi length Δl_i over all nodes [m]
 
   int num_dofs = 0;
   int num_nodes = 0;

@@ -1,0 +1,247 @@
+#include "stokesrods/fluid/mobility_operator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <unordered_map>
+
+#include "stokesrods/common/assert.h"
+#include "stokesrods/fluid/rss.h"
+#include "stokesrods/fluid/stokeslet_segment.h"
+
+namespace stokesrods {
+
+void MobilityOperator::SetLayout(const std::vector<HydroRod>& rods) {
+  node_offset_.assign(1, 0);
+  for (const HydroRod& rod : rods)
+    node_offset_.push_back(node_offset_.back() + static_cast<int>(rod.x->cols()));
+}
+
+namespace {
+
+class DenseMobility final : public MobilityOperator {
+ public:
+  explicit DenseMobility(const FluidParams& params) : params_(params) {}
+
+  void Update(const std::vector<HydroRod>& rods) override {
+    SetLayout(rods);
+    AssembleMobility(params_, rods, &matrix_);
+  }
+  void Apply(const VecX& force, VecX* velocity) const override {
+    velocity->noalias() = matrix_ * force;
+  }
+  MatX SelfBlock(int rod) const override {
+    const int first = 3 * node_offset(rod), n = 3 * (node_offset(rod + 1) - node_offset(rod));
+    return matrix_.block(first, first, n, n);
+  }
+  const MatX* matrix() const override { return &matrix_; }
+
+ private:
+  FluidParams params_;
+  MatX matrix_;
+};
+
+// Matrix-free RSS (see the header). With f_j = F_j/Λ_j the force densities at the nodes,
+//   8πμ U_t = Σ_segments (A_a f_a + A_b f_b)
+//           = Σ_far Σ_q w_q L S_ε(x_t − y_q) [(1 − α_q) f_a + α_q f_b]    (point Stokeslets)
+//           + Σ_near (A_a − A_a^Gauss) f_a + (A_b − A_b^Gauss) f_b,       (exact minus the rule)
+// where the first sum runs over all segments (the fast sum) and the second corrects the near
+// pairs to the closed forms. The corrections are stored per target as 3×3 blocks acting on F.
+class MatrixFreeRssMobility final : public MobilityOperator {
+ public:
+  MatrixFreeRssMobility(const FluidParams& params, const MobilityOptions& options)
+      : params_(params), options_(options), split_(ChooseNearFarSplit(options.tolerance)) {}
+
+  void Update(const std::vector<HydroRod>& rods) override;
+  void Apply(const VecX& force, VecX* velocity) const override;
+  MatX SelfBlock(int rod) const override {
+    MatX block;
+    AssembleRssMobility(params_, {rods_[static_cast<size_t>(rod)]}, &block);
+    return block;
+  }
+
+ private:
+  struct Segment {
+    int a = 0;  // global node index of x_a (x_b is a + 1)
+    double eps = 0.0;
+  };
+  void FindNearPairs(const Matrix3X& targets);
+
+  FluidParams params_;
+  MobilityOptions options_;
+  NearFarSplit split_;
+  std::vector<HydroRod> rods_;
+  Matrix3X nodes_;                  // 3 × M
+  VecX inverse_voronoi_;            // 1/Λ_j
+  std::vector<Segment> segments_;
+  Matrix3X gauss_points_;           // 3 × (segments × points)
+  VecX gauss_eps_;
+  std::unique_ptr<StokesletSum> far_;
+  // Near corrections: for target t, blocks near_block_[k] acting on node near_source_[k],
+  // k ∈ [near_start_[t], near_start_[t + 1]).
+  std::vector<int> near_start_, near_source_;
+  std::vector<Mat3> near_block_;
+  mutable Matrix3X strengths_, far_velocity_;
+};
+
+void MatrixFreeRssMobility::Update(const std::vector<HydroRod>& rods) {
+  SetLayout(rods);
+  rods_ = rods;
+  const int m = node_offset(num_rods());
+  nodes_.resize(3, m);
+  inverse_voronoi_.resize(m);
+  segments_.clear();
+  for (int r = 0; r < num_rods(); ++r) {
+    const Matrix3X& x = *rods[static_cast<size_t>(r)].x;
+    const int first = node_offset(r);
+    nodes_.middleCols(first, x.cols()) = x;
+    inverse_voronoi_.segment(first, x.cols()) = VoronoiLengths(x).cwiseInverse();
+    const double eps = params_.regularization * rods[static_cast<size_t>(r)].radius;
+    for (int j = 0; j + 1 < x.cols(); ++j) segments_.push_back({first + j, eps});
+  }
+  const double* alpha = nullptr;
+  const double* weight = nullptr;
+  GaussLegendreRule01(split_.gauss_points, &alpha, &weight);
+  const int g = split_.gauss_points;
+  gauss_points_.resize(3, static_cast<Eigen::Index>(segments_.size()) * g);
+  gauss_eps_.resize(gauss_points_.cols());
+  for (std::size_t s = 0; s < segments_.size(); ++s) {
+    const Vec3 xa = nodes_.col(segments_[s].a), xb = nodes_.col(segments_[s].a + 1);
+    for (int q = 0; q < g; ++q) {
+      gauss_points_.col(static_cast<Eigen::Index>(s) * g + q) = xa + alpha[q] * (xb - xa);
+      gauss_eps_(static_cast<Eigen::Index>(s) * g + q) = segments_[s].eps;
+    }
+  }
+  const double pairs = static_cast<double>(gauss_points_.cols()) * static_cast<double>(m);
+  if (!far_) {
+    far_ = pairs < options_.direct_sum_below
+               ? MakeDirectStokesletSum()
+               : MakeFastStokesletSum({.tolerance = options_.tolerance});
+  }
+  far_->Build(gauss_points_, gauss_eps_, nodes_);
+  FindNearPairs(nodes_);
+}
+
+// Near pairs by a uniform grid of segment midpoints, cells of the near radius plus half the
+// longest segment, so that every segment within the near radius of a target has its midpoint in
+// the 27 cells around the target.
+void MatrixFreeRssMobility::FindNearPairs(const Matrix3X& targets) {
+  double longest = 0.0, max_eps = 0.0;
+  for (const Segment& s : segments_) {
+    longest = std::max(longest, (nodes_.col(s.a + 1) - nodes_.col(s.a)).norm());
+    max_eps = std::max(max_eps, s.eps);
+  }
+  const double reach = split_.near_delta * longest;  // d < δ_near L ≤ this
+  const double cell = reach + 0.5 * longest;
+  auto key = [&](const Vec3& p, int dx, int dy, int dz) {
+    const auto c = [&](double v, int d) {
+      return static_cast<std::int64_t>(std::floor(v / cell)) + d + (1 << 20);
+    };
+    return (c(p.x(), dx) << 42) | (c(p.y(), dy) << 21) | c(p.z(), dz);
+  };
+  std::unordered_map<std::int64_t, std::vector<int>> grid;
+  for (std::size_t s = 0; s < segments_.size(); ++s) {
+    const Vec3 mid = 0.5 * (nodes_.col(segments_[s].a) + nodes_.col(segments_[s].a + 1));
+    grid[key(mid, 0, 0, 0)].push_back(static_cast<int>(s));
+  }
+  const double scale = 1.0 / (8.0 * kPi * params_.viscosity);
+  const int m = static_cast<int>(targets.cols());
+  near_start_.assign(1, 0);
+  near_source_.clear();
+  near_block_.clear();
+  std::vector<int> candidates;
+  std::unordered_map<int, Mat3> blocks;  // per target: source node → block
+  for (int t = 0; t < m; ++t) {
+    const Vec3 p = targets.col(t);
+    blocks.clear();
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          const auto it = grid.find(key(p, dx, dy, dz));
+          if (it == grid.end()) continue;
+          for (int s : it->second) {
+            const Segment& seg = segments_[static_cast<size_t>(s)];
+            const Vec3 xa = nodes_.col(seg.a), xb = nodes_.col(seg.a + 1);
+            const Vec3 v = xb - xa;
+            const double alpha = std::clamp((p - xa).dot(v) / v.squaredNorm(), 0.0, 1.0);
+            const double d2 = (p - xa - alpha * v).squaredNorm() + seg.eps * seg.eps;
+            if (d2 >= split_.near_delta * split_.near_delta * v.squaredNorm()) continue;
+            const SegmentMobility exact = StokesletSegment(xa, xb, seg.eps, p);
+            const SegmentMobility rule =
+                StokesletSegmentGauss(xa, xb, seg.eps, p, split_.gauss_points);
+            auto add = [&](int node, const Mat3& block) {
+              auto [slot, inserted] = blocks.try_emplace(node, Mat3::Zero());
+              slot->second += scale * inverse_voronoi_(node) * block;
+            };
+            add(seg.a, exact.a - rule.a);
+            add(seg.a + 1, exact.b - rule.b);
+          }
+        }
+    for (const auto& [node, block] : blocks) {
+      near_source_.push_back(node);
+      near_block_.push_back(block);
+    }
+    near_start_.push_back(static_cast<int>(near_source_.size()));
+  }
+  (void)max_eps;
+}
+
+void MatrixFreeRssMobility::Apply(const VecX& force, VecX* velocity) const {
+  const int m = nodes_.cols();
+  SR_ASSERT(force.size() == 3 * m, "mobility: force vector of the wrong size");
+  const int g = split_.gauss_points;
+  const double* alpha = nullptr;
+  const double* weight = nullptr;
+  GaussLegendreRule01(g, &alpha, &weight);
+  strengths_.resize(3, gauss_points_.cols());
+  for (std::size_t s = 0; s < segments_.size(); ++s) {
+    const int a = segments_[s].a;
+    const double length = (nodes_.col(a + 1) - nodes_.col(a)).norm();
+    const Vec3 fa = force.segment<3>(3 * a) * inverse_voronoi_(a);
+    const Vec3 fb = force.segment<3>(3 * (a + 1)) * inverse_voronoi_(a + 1);
+    for (int q = 0; q < g; ++q)
+      strengths_.col(static_cast<Eigen::Index>(s) * g + q) =
+          (weight[q] * length) * ((1.0 - alpha[q]) * fa + alpha[q] * fb);
+  }
+  far_->Apply(strengths_, &far_velocity_);
+  velocity->resize(3 * m);
+  const double scale = 1.0 / (8.0 * kPi * params_.viscosity);
+#pragma omp parallel for schedule(static)
+  for (int t = 0; t < m; ++t) {
+    Vec3 u = scale * far_velocity_.col(t);
+    for (int k = near_start_[static_cast<size_t>(t)]; k < near_start_[static_cast<size_t>(t) + 1]; ++k)
+      u += near_block_[static_cast<size_t>(k)] * force.segment<3>(3 * near_source_[static_cast<size_t>(k)]);
+    velocity->segment<3>(3 * t) = u;
+  }
+}
+
+}  // namespace
+
+NearFarSplit ChooseNearFarSplit(double tolerance) {
+  // The n-point Gauss–Legendre rule on one segment–node pair, relative to the pair's |A|, at
+  // δ = √(d² + ε²)/L: measured worst over random points and ε ∈ {0.05, 0.3} L (the table in
+  // docs/performance.md; tests/fluid/mobility_operator_test.cc checks it), it falls like
+  //     e_n(δ) ≈ c_n δ^−(2n−1),   c_n ≈ 9.6e-3 · 13.5^−(n−2)
+  // (c_2..c_6 = 9.6e-3, 7.6e-4, 5.6e-5, 3.9e-6, 2.7e-7). With a factor 2 of margin on c_n, the
+  // near radius for n points is δ_n = (2 c_n / tolerance)^(1/(2n−1)); we take the fewest points
+  // whose near radius is at most 2.5 segment lengths (more points cost every product, a larger
+  // near zone costs exact integrals once per step and a denser correction).
+  NearFarSplit split;
+  const double tol = std::max(tolerance, 1e-15);
+  for (int n = 2; n <= 12; ++n) {
+    const double c = 2.0 * 9.6e-3 * std::pow(13.5, -(n - 2.0));
+    split.gauss_points = n;
+    split.near_delta = std::max(1.0, std::pow(c / tol, 1.0 / (2.0 * n - 1.0)));
+    if (split.near_delta <= 2.5) break;
+  }
+  return split;
+}
+
+std::unique_ptr<MobilityOperator> MakeMobilityOperator(const FluidParams& params,
+                                                       const MobilityOptions& options) {
+  if (options.kind == MobilityKind::kMatrixFree && params.model == FluidModel::kRss)
+    return std::make_unique<MatrixFreeRssMobility>(params, options);
+  return std::make_unique<DenseMobility>(params);
+}
+
+}  // namespace stokesrods

@@ -1,0 +1,72 @@
+// The fluid as a linear operator: U = 𝕄 F over all hydrodynamic nodes (paper eq. 21), applied
+// without necessarily forming 𝕄.
+//
+// Every consumer of the hydrodynamics (the implicit step, the explicit drag, the flow field)
+// needs only three things: the geometry at which 𝕄 is taken (Update), products U = 𝕄 F (Apply),
+// and, to precondition its solves, the self-mobility of each rod (SelfBlock). Two
+// implementations:
+//   dense      : 𝕄 assembled in full (fluid/hydrodynamics.h), Apply a matrix–vector product. The
+//                reference; O(M²) memory and assembly. All models (RSS, LSBT, RFT).
+//   matrix-free: RSS only. Each segment–node interaction is either "near" (δ = √(d² + ε²)/L below
+//                a bound set by the tolerance), integrated exactly by the closed forms of
+//                stokeslet_segment.h and stored as 3×3 blocks, or "far", integrated by a
+//                Gauss–Legendre rule whose point Stokeslets are summed by a fast summation
+//                (stokeslet_sum.h). O(M) memory.
+// Further sources of flow (cell bodies, wall images) extend the node set and the kernel behind the
+// same interface.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "stokesrods/fluid/hydrodynamics.h"
+#include "stokesrods/fluid/stokeslet_sum.h"
+
+namespace stokesrods {
+
+enum class MobilityKind { kDense, kMatrixFree };
+
+struct MobilityOptions {
+  MobilityKind kind = MobilityKind::kDense;
+  /// Matrix-free: bound on the relative error of each far segment–node interaction (quadrature)
+  /// and of the fast sum [–].
+  double tolerance = 1e-8;
+  /// Matrix-free: the far-field sum runs directly below this many source–target pairs.
+  double direct_sum_below = 4e6;
+};
+
+class MobilityOperator {
+ public:
+  virtual ~MobilityOperator() = default;
+  /// Takes the geometry: 𝕄 = 𝕄(x) for the rods as they are now.
+  virtual void Update(const std::vector<HydroRod>& rods) = 0;
+  /// U = 𝕄 F (3M each) at the geometry of the last Update.
+  virtual void Apply(const VecX& force, VecX* velocity) const = 0;
+  /// The block of 𝕄 coupling rod k's nodes to themselves (3N_k × 3N_k), exact.
+  virtual MatX SelfBlock(int rod) const = 0;
+  /// The assembled 𝕄 when the operator holds one, else nullptr.
+  virtual const MatX* matrix() const { return nullptr; }
+
+  int size() const { return 3 * static_cast<int>(node_offset_.back()); }
+  int num_rods() const { return static_cast<int>(node_offset_.size()) - 1; }
+  /// First node of rod k among all nodes; node_offset(num_rods()) = M.
+  int node_offset(int rod) const { return node_offset_[static_cast<size_t>(rod)]; }
+
+ protected:
+  void SetLayout(const std::vector<HydroRod>& rods);
+  std::vector<int> node_offset_ = {0};
+};
+
+/// The operator for the fluid model and options (matrix-free needs RSS; others fall back to dense).
+std::unique_ptr<MobilityOperator> MakeMobilityOperator(const FluidParams& params,
+                                                       const MobilityOptions& options);
+
+/// Near/far split of the matrix-free RSS: the far rule's number of Gauss points per segment and
+/// the δ = √(d² + ε²)/L below which a segment–node pair is integrated exactly, for a tolerance.
+struct NearFarSplit {
+  int gauss_points = 3;
+  double near_delta = 0.0;
+};
+NearFarSplit ChooseNearFarSplit(double tolerance);
+
+}  // namespace stokesrods

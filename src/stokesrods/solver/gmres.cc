@@ -1,0 +1,93 @@
+#include "stokesrods/solver/gmres.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace stokesrods {
+
+GmresReport SolveGmres(const LinearOperator& a, const LinearOperator& preconditioner,
+                       const VecX& b, const GmresOptions& options, VecX* x, VecX* ax) {
+  const Eigen::Index n = b.size();
+  if (x->size() != n) x->setZero(n);
+  GmresReport report;
+  const double b_norm = b.norm();
+  if (b_norm == 0.0) {
+    x->setZero();
+    if (ax) ax->setZero(n);
+    report.converged = true;
+    return report;
+  }
+  const int m = std::max(1, options.restart);
+  MatX v(n, m + 1);             // Arnoldi basis
+  MatX z(n, m);                 // preconditioned directions P⁻¹ v_j (flexible form: no re-apply)
+  MatX hess = MatX::Zero(m + 1, m);
+  VecX cs(m), sn(m), g(m + 1);
+  VecX w(n), r(n);
+  auto apply_p = [&](const VecX& in, VecX* out) {
+    if (preconditioner) preconditioner(in, out); else *out = in;
+  };
+
+  VecX product = VecX::Zero(n);  // A x
+  if (!x->isZero(0.0)) a(*x, &product);
+  r = b - product;
+  double r_norm = r.norm();
+  while (true) {
+    report.relative_residual = r_norm / b_norm;
+    report.converged = report.relative_residual <= options.tolerance ||
+                       r_norm <= options.absolute_tolerance;
+    if (report.converged || report.iterations >= options.max_iterations) {
+      if (ax) *ax = product;
+      return report;
+    }
+    v.col(0) = r / r_norm;
+    g.setZero();
+    g(0) = r_norm;
+    hess.setZero();
+    int k = 0;
+    for (; k < m && report.iterations < options.max_iterations; ++k) {
+      VecX zk(n);
+      apply_p(v.col(k), &zk);
+      z.col(k) = zk;
+      a(zk, &w);
+      ++report.iterations;
+      for (int i = 0; i <= k; ++i) {  // modified Gram–Schmidt
+        hess(i, k) = v.col(i).dot(w);
+        w -= hess(i, k) * v.col(i);
+      }
+      hess(k + 1, k) = w.norm();
+      if (hess(k + 1, k) > 0.0) v.col(k + 1) = w / hess(k + 1, k);
+      for (int i = 0; i < k; ++i) {  // previous rotations on the new column
+        const double t = cs(i) * hess(i, k) + sn(i) * hess(i + 1, k);
+        hess(i + 1, k) = -sn(i) * hess(i, k) + cs(i) * hess(i + 1, k);
+        hess(i, k) = t;
+      }
+      const double denom = std::hypot(hess(k, k), hess(k + 1, k));
+      cs(k) = denom > 0.0 ? hess(k, k) / denom : 1.0;
+      sn(k) = denom > 0.0 ? hess(k + 1, k) / denom : 0.0;
+      hess(k, k) = denom;
+      hess(k + 1, k) = 0.0;
+      g(k + 1) = -sn(k) * g(k);
+      g(k) = cs(k) * g(k);
+      // |g(k+1)| is the residual norm of the least-squares problem (in exact arithmetic).
+      if (std::abs(g(k + 1)) <= 0.5 * std::max(options.tolerance * b_norm,
+                                               options.absolute_tolerance) ||
+          hess(k, k) == 0.0) {
+        ++k;
+        break;
+      }
+    }
+    // Back substitution for y (k × k upper triangular), x += Z y.
+    VecX y = g.head(k);
+    for (int i = k - 1; i >= 0; --i) {
+      for (int j = i + 1; j < k; ++j) y(i) -= hess(i, j) * y(j);
+      y(i) = hess(i, i) != 0.0 ? y(i) / hess(i, i) : 0.0;
+    }
+    *x += z.leftCols(k) * y;
+    a(*x, &product);  // the true residual, so the test cannot be fooled by a drifting estimate
+    r = b - product;
+    r_norm = r.norm();
+  }
+}
+
+}  // namespace stokesrods

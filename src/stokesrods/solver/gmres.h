@@ -1,0 +1,38 @@
+// Restarted GMRES with right preconditioning (Saad & Schultz 1986; Saad, Iterative Methods for
+// Sparse Linear Systems, 2nd ed., Algorithm 9.5), for operators given only by their products.
+//
+// Solves A x = b by minimizing |b − A P⁻¹ y| over a Krylov space of A P⁻¹, x = P⁻¹ y. With right
+// preconditioning the residual it monitors is the true residual of A x = b (not a preconditioned
+// one), so the stopping test |b − A x| ≤ tolerance |b| means what it says. Arnoldi by modified
+// Gram–Schmidt, the least-squares problem by Givens rotations.
+#pragma once
+
+#include <functional>
+
+#include "stokesrods/common/types.h"
+
+namespace stokesrods {
+
+/// y = A x (or y = P⁻¹ x); y is resized by the caller to the size of x.
+using LinearOperator = std::function<void(const VecX& x, VecX* y)>;
+
+struct GmresOptions {
+  double tolerance = 1e-10;  ///< stop when |b − A x| ≤ tolerance |b|  [–]
+  double absolute_tolerance = 0.0;  ///< or when |b − A x| ≤ this (units of b)
+  int max_iterations = 200;  ///< products with A, over all restarts
+  int restart = 50;          ///< Krylov dimension before a restart
+};
+
+struct GmresReport {
+  bool converged = false;
+  int iterations = 0;        ///< products with A
+  double relative_residual = 0.0;  ///< |b − A x| / |b| at the end (recomputed, not estimated)
+};
+
+/// Solves A x = b; x holds the initial guess on entry (resized to zero if empty) and the
+/// solution on exit; `ax`, if given, receives A x of the returned x (computed, one product that
+/// the final residual needs anyway). `preconditioner` may be empty (identity).
+GmresReport SolveGmres(const LinearOperator& a, const LinearOperator& preconditioner,
+                       const VecX& b, const GmresOptions& options, VecX* x, VecX* ax = nullptr);
+
+}  // namespace stokesrods

@@ -1,0 +1,215 @@
+// The fast sum of regularized Stokeslets against the direct sum: random clouds and the helix
+// lattice of bench/bench_stokeslet_sum.cc at several tolerances, and the edge cases (a target on
+// a source, mixed ε, tiny problems, collinear points, six decades of distance).
+#include "stokesrods/fluid/stokeslet_sum.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include "stokesrods/fluid/stokeslet_segment.h"
+
+namespace stokesrods {
+namespace {
+
+struct Cloud {
+  Matrix3X sources, targets;
+  VecX regularization;
+};
+
+Matrix3X RandomStrengths(int n, std::mt19937* rng) {
+  std::normal_distribution<double> normal;
+  Matrix3X g(3, n);
+  for (int k = 0; k < n; ++k) g.col(k) = Vec3(normal(*rng), normal(*rng), normal(*rng));
+  return g;
+}
+
+Cloud RandomCloud(int ns, int nt, double size, double eps, std::mt19937* rng) {
+  std::uniform_real_distribution<double> unit(0.0, size);
+  Cloud c;
+  c.sources.resize(3, ns);
+  c.targets.resize(3, nt);
+  for (int k = 0; k < ns; ++k) c.sources.col(k) = Vec3(unit(*rng), unit(*rng), unit(*rng));
+  for (int k = 0; k < nt; ++k) c.targets.col(k) = Vec3(unit(*rng), unit(*rng), unit(*rng));
+  c.regularization = VecX::Constant(ns, eps);
+  return c;
+}
+
+// Helices of 65 nodes (radius 0.01 m, pitch 0.05 m, axis 0.2 m along −z) on a square lattice
+// 0.04 m apart; sources: 2 Gauss points per segment, ε = 1.02e-3 m; targets: the nodes.
+Cloud HelixLattice(int rows, int cols) {
+  const int nodes = 65;
+  const double radius = 0.01, pitch = 0.05, length = 0.2, spacing = 0.04;
+  Cloud c;
+  c.targets.resize(3, rows * cols * nodes);
+  c.sources.resize(3, rows * cols * 2 * (nodes - 1));
+  int nt = 0, ns = 0;
+  for (int i = 0; i < rows; ++i) {
+    for (int j = 0; j < cols; ++j) {
+      const Vec3 base(spacing * i, spacing * j, 0.0);
+      auto at = [&](double z) {
+        const double phi = 2.0 * kPi * z / pitch;
+        return Vec3(base + Vec3(radius * std::cos(phi), radius * std::sin(phi), -z));
+      };
+      for (int k = 0; k < nodes; ++k) c.targets.col(nt++) = at(length * k / (nodes - 1));
+      for (int k = 0; k + 1 < nodes; ++k)
+        for (double a : {0.5 - 0.5 / std::sqrt(3.0), 0.5 + 0.5 / std::sqrt(3.0)})
+          c.sources.col(ns++) = at(length * (k + a) / (nodes - 1));
+    }
+  }
+  c.regularization = VecX::Constant(ns, 1.02e-3);
+  return c;
+}
+
+// max over targets of |w − w_ref| / Σ_s |S(x_t − y_s)|₂ |g_s|, the error measure of the header.
+double RelativeError(const Cloud& c, const Matrix3X& g, const Matrix3X& w, const Matrix3X& ref) {
+  double worst = 0.0;
+  for (int t = 0; t < c.targets.cols(); ++t) {
+    double scale = 0.0;
+    for (int s = 0; s < c.sources.cols(); ++s) {
+      const Vec3 r = c.targets.col(t) - c.sources.col(s);
+      const double e2 = c.regularization[s] * c.regularization[s];
+      const double big_r = std::sqrt(r.squaredNorm() + e2);
+      // The eigenvalues of S_ε are 1/R + ε²/R³ (twice) and 1/R + (ε² + r²)/R³, the largest.
+      scale += (1.0 / big_r + (e2 + r.squaredNorm()) / (big_r * big_r * big_r)) * g.col(s).norm();
+    }
+    worst = std::max(worst, (w.col(t) - ref.col(t)).norm() / scale);
+  }
+  return worst;
+}
+
+struct Result {
+  double error = 0.0;
+  StokesletSumStats stats;
+};
+
+Result Compare(const Cloud& c, StokesletSumOptions options, std::mt19937* rng) {
+  auto direct = MakeDirectStokesletSum();
+  auto fast = MakeFastStokesletSum(options);
+  direct->Build(c.sources, c.regularization, c.targets);
+  fast->Build(c.sources, c.regularization, c.targets);
+  const Matrix3X g = RandomStrengths(static_cast<int>(c.sources.cols()), rng);
+  Matrix3X w, ref;
+  direct->Apply(g, &ref);
+  fast->Apply(g, &w);
+  EXPECT_TRUE(w.allFinite());
+  Matrix3X w2;  // Apply is repeatable (the scratch is reset)
+  fast->Apply(g, &w2);
+  EXPECT_TRUE(w == w2) << "Apply is not repeatable";
+  return {RelativeError(c, g, w, ref), fast->Stats()};
+}
+
+TEST(StokesletSumTest, DirectSumMatchesTheKernel) {
+  std::mt19937 rng(1);
+  Cloud c = RandomCloud(7, 5, 1.0, 0.1, &rng);
+  c.regularization[3] = 0.3;
+  c.targets.col(2) = c.sources.col(4);  // a target on a source: S_ε(0) = (2/ε) I
+  const Matrix3X g = RandomStrengths(7, &rng);
+  auto direct = MakeDirectStokesletSum();
+  direct->Build(c.sources, c.regularization, c.targets);
+  Matrix3X w;
+  direct->Apply(g, &w);
+  for (int t = 0; t < 5; ++t) {
+    Vec3 ref = Vec3::Zero();
+    for (int s = 0; s < 7; ++s)
+      ref += RegularizedStokesletMatrix(c.targets.col(t) - c.sources.col(s), c.regularization[s]) *
+             g.col(s);
+    EXPECT_LT((w.col(t) - ref).norm(), 1e-14 * ref.norm()) << t;
+  }
+}
+
+TEST(StokesletSumTest, RandomCloudsMeetTheTolerance) {
+  std::mt19937 rng(2);
+  const Cloud c = RandomCloud(2000, 1200, 1.0, 0.01, &rng);
+  for (double tol : {1e-4, 1e-6, 1e-8}) {
+    const Result r = Compare(c, {.tolerance = tol, .direct_below_pairs = 0}, &rng);
+    std::printf("random cloud, tolerance %.0e: error %.2e, far pairs %lld, max rank %d\n", tol,
+                r.error, static_cast<long long>(r.stats.far_pairs), r.stats.max_rank);
+    EXPECT_LT(r.error, tol) << tol;
+    EXPECT_GT(r.error, 1e-4 * tol) << "suspiciously exact: " << tol;
+    EXPECT_GT(r.stats.far_pairs, 0) << tol;
+    EXPECT_EQ(r.stats.far_pairs + r.stats.near_pairs, 2000LL * 1200);
+  }
+}
+
+TEST(StokesletSumTest, HelixLatticeMeetsTheTolerance) {
+  std::mt19937 rng(3);
+  const Cloud c = HelixLattice(2, 5);  // 10 helices: 1280 sources, 650 targets
+  for (double tol : {1e-4, 1e-6, 1e-8}) {
+    const Result r = Compare(c, {.tolerance = tol, .direct_below_pairs = 0}, &rng);
+    std::printf("10 helices, tolerance %.0e: error %.2e, far pairs %lld, max rank %d\n", tol,
+                r.error, static_cast<long long>(r.stats.far_pairs), r.stats.max_rank);
+    EXPECT_LT(r.error, tol) << tol;
+    EXPECT_GT(r.error, 1e-4 * tol) << tol;
+    EXPECT_GT(r.stats.far_pairs, 0) << tol;
+  }
+}
+
+TEST(StokesletSumTest, OverTheMemoryBudgetSumsDirectly) {
+  std::mt19937 rng(8);
+  const Cloud c = HelixLattice(2, 5);
+  const Result r = Compare(c, {.direct_below_pairs = 0, .max_megabytes = 0.01}, &rng);
+  EXPECT_EQ(r.stats.far_pairs, 0);
+  EXPECT_LT(r.error, 1e-15);
+}
+
+TEST(StokesletSumTest, MixedRegularizationAndTargetsOnSources) {
+  std::mt19937 rng(4);
+  Cloud c = RandomCloud(1500, 1000, 0.1, 1e-3, &rng);
+  std::uniform_real_distribution<double> eps(1e-4, 2e-2);
+  for (int s = 0; s < c.sources.cols(); ++s) c.regularization[s] = eps(rng);
+  for (int t = 0; t < 500; ++t) c.targets.col(t) = c.sources.col(3 * t);
+  const Result r = Compare(c, {.tolerance = 1e-6, .direct_below_pairs = 0}, &rng);
+  EXPECT_LT(r.error, 1e-6);
+  EXPECT_GT(r.stats.far_pairs, 0);
+}
+
+TEST(StokesletSumTest, TinyProblems) {
+  std::mt19937 rng(5);
+  for (auto [ns, nt] : {std::pair{1, 1}, {1, 50}, {50, 1}, {2, 3}, {40, 40}}) {
+    const Cloud c = RandomCloud(ns, nt, 1.0, 0.05, &rng);
+    for (std::int64_t direct_below : {0, 1'000'000}) {
+      const Result r = Compare(c, {.tolerance = 1e-8, .direct_below_pairs = direct_below}, &rng);
+      EXPECT_LT(r.error, 1e-8) << ns << " " << nt;
+    }
+  }
+}
+
+TEST(StokesletSumTest, PointsOnALine) {
+  std::mt19937 rng(6);
+  Cloud c = RandomCloud(2000, 1000, 1.0, 1e-3, &rng);
+  c.sources.row(1).setZero();
+  c.sources.row(2).setZero();
+  c.targets.row(1).setZero();
+  c.targets.row(2).setZero();
+  const Result r = Compare(c, {.tolerance = 1e-6, .direct_below_pairs = 0}, &rng);
+  EXPECT_LT(r.error, 1e-6);
+  EXPECT_GT(r.stats.far_pairs, 0);
+}
+
+TEST(StokesletSumTest, SixDecadesOfDistance) {
+  // 19 balls of 100 sources and 60 targets, centred 10^(−k/3) m from the origin (k = 0 … 18) in
+  // random directions, of radius 0.2 × that distance: distances from 2e-8 m to 2 m, ε = 1e-8 m.
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal;
+  auto direction = [&] { return Vec3(Vec3(normal(rng), normal(rng), normal(rng)).normalized()); };
+  Cloud c;
+  c.sources.resize(3, 1900);
+  c.targets.resize(3, 1140);
+  for (int k = 0; k < 19; ++k) {
+    const double distance = std::pow(10.0, -k / 3.0);
+    const Vec3 centre = distance * direction();
+    std::uniform_real_distribution<double> radius(0.0, 0.2 * distance);
+    for (int s = 0; s < 100; ++s) c.sources.col(100 * k + s) = centre + radius(rng) * direction();
+    for (int t = 0; t < 60; ++t) c.targets.col(60 * k + t) = centre + radius(rng) * direction();
+  }
+  c.regularization = VecX::Constant(1900, 1e-8);
+  const Result r = Compare(c, {.tolerance = 1e-6, .direct_below_pairs = 0}, &rng);
+  EXPECT_LT(r.error, 1e-6);
+  EXPECT_GT(r.stats.far_pairs, r.stats.near_pairs);
+}
+
+}  // namespace
+}  // namespace stokesrods
