@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <iostream>
 #include <new>
@@ -303,5 +304,9 @@ int main(int argc, char** argv) {
   j["threads"] = MaxThreads();
   j["peak_rss_mb"] = PeakRssMb();
   std::cout << j.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace) << '\n';
-  return code;
+  std::cout.flush();
+  // After a std::bad_alloc thrown inside an OpenMP parallel region the other threads can be left
+  // waiting at its barrier, and a normal exit would wait for them forever: leave at once.
+  std::fflush(nullptr);
+  std::_Exit(code);
 }

@@ -141,14 +141,17 @@ def run_case(args, case, threads, mem_limit_bytes):
     lines = [l for l in stdout.splitlines() if l.strip().startswith("{")]
     if lines:
         try:
-            row.update(json.loads(lines[-1]))
+            result = json.loads(lines[-1])
+            result["omp_max_threads"] = result.pop("threads", None)  # what the child saw
+            row.update(result)
         except json.JSONDecodeError:
             pass
-    row["threads"] = threads
     model, progress = parse_progress(stderr)
     for key, value in model.items():
         row.setdefault(key, value)
-    if timed_out:
+    if timed_out and row.get("ok") is False and "message" in row:
+        row["message"] += f" (then hung, killed after {args.timeout:g} s)"
+    elif timed_out:
         row["ok"] = False
         row["message"] = f"timed out after {args.timeout:g} s" + progress
     elif "ok" not in row:

@@ -124,7 +124,7 @@ TEST(StokesletSumTest, RandomCloudsMeetTheTolerance) {
   std::mt19937 rng(2);
   const Cloud c = RandomCloud(2000, 1200, 1.0, 0.01, &rng);
   for (double tol : {1e-4, 1e-6, 1e-8}) {
-    const Result r = Compare(c, {.tolerance = tol, .direct_below_pairs = 0}, &rng);
+    const Result r = Compare(c, {.tolerance = tol, .direct_below_pairs = 0, .choose_by_cost = false}, &rng);
     std::printf("random cloud, tolerance %.0e: error %.2e, far pairs %lld, max rank %d\n", tol,
                 r.error, static_cast<long long>(r.stats.far_pairs), r.stats.max_rank);
     EXPECT_LT(r.error, tol) << tol;
@@ -138,7 +138,7 @@ TEST(StokesletSumTest, HelixLatticeMeetsTheTolerance) {
   std::mt19937 rng(3);
   const Cloud c = HelixLattice(2, 5);  // 10 helices: 1280 sources, 650 targets
   for (double tol : {1e-4, 1e-6, 1e-8}) {
-    const Result r = Compare(c, {.tolerance = tol, .direct_below_pairs = 0}, &rng);
+    const Result r = Compare(c, {.tolerance = tol, .direct_below_pairs = 0, .choose_by_cost = false}, &rng);
     std::printf("10 helices, tolerance %.0e: error %.2e, far pairs %lld, max rank %d\n", tol,
                 r.error, static_cast<long long>(r.stats.far_pairs), r.stats.max_rank);
     EXPECT_LT(r.error, tol) << tol;
@@ -150,9 +150,16 @@ TEST(StokesletSumTest, HelixLatticeMeetsTheTolerance) {
 TEST(StokesletSumTest, OverTheMemoryBudgetSumsDirectly) {
   std::mt19937 rng(8);
   const Cloud c = HelixLattice(2, 5);
-  const Result r = Compare(c, {.direct_below_pairs = 0, .max_megabytes = 0.01}, &rng);
+  const Result r = Compare(c, {.direct_below_pairs = 0, .max_megabytes = 0.01, .choose_by_cost = false}, &rng);
   EXPECT_EQ(r.stats.far_pairs, 0);
   EXPECT_LT(r.error, 1e-15);
+}
+
+TEST(StokesletSumTest, SumsDirectlyWhenTheTreeDoesNotPay) {
+  std::mt19937 rng(9);
+  const Cloud c = HelixLattice(2, 5);  // measured: the vectorized direct sum is faster here
+  const Result r = Compare(c, {.direct_below_pairs = 0}, &rng);
+  EXPECT_EQ(r.stats.far_pairs, 0);
 }
 
 TEST(StokesletSumTest, MixedRegularizationAndTargetsOnSources) {
@@ -161,7 +168,7 @@ TEST(StokesletSumTest, MixedRegularizationAndTargetsOnSources) {
   std::uniform_real_distribution<double> eps(1e-4, 2e-2);
   for (int s = 0; s < c.sources.cols(); ++s) c.regularization[s] = eps(rng);
   for (int t = 0; t < 500; ++t) c.targets.col(t) = c.sources.col(3 * t);
-  const Result r = Compare(c, {.tolerance = 1e-6, .direct_below_pairs = 0}, &rng);
+  const Result r = Compare(c, {.tolerance = 1e-6, .direct_below_pairs = 0, .choose_by_cost = false}, &rng);
   EXPECT_LT(r.error, 1e-6);
   EXPECT_GT(r.stats.far_pairs, 0);
 }
@@ -171,7 +178,7 @@ TEST(StokesletSumTest, TinyProblems) {
   for (auto [ns, nt] : {std::pair{1, 1}, {1, 50}, {50, 1}, {2, 3}, {40, 40}}) {
     const Cloud c = RandomCloud(ns, nt, 1.0, 0.05, &rng);
     for (std::int64_t direct_below : {0, 1'000'000}) {
-      const Result r = Compare(c, {.tolerance = 1e-8, .direct_below_pairs = direct_below}, &rng);
+      const Result r = Compare(c, {.tolerance = 1e-8, .direct_below_pairs = direct_below, .choose_by_cost = false}, &rng);
       EXPECT_LT(r.error, 1e-8) << ns << " " << nt;
     }
   }
@@ -184,7 +191,7 @@ TEST(StokesletSumTest, PointsOnALine) {
   c.sources.row(2).setZero();
   c.targets.row(1).setZero();
   c.targets.row(2).setZero();
-  const Result r = Compare(c, {.tolerance = 1e-6, .direct_below_pairs = 0}, &rng);
+  const Result r = Compare(c, {.tolerance = 1e-6, .direct_below_pairs = 0, .choose_by_cost = false}, &rng);
   EXPECT_LT(r.error, 1e-6);
   EXPECT_GT(r.stats.far_pairs, 0);
 }
@@ -206,7 +213,7 @@ TEST(StokesletSumTest, SixDecadesOfDistance) {
     for (int t = 0; t < 60; ++t) c.targets.col(60 * k + t) = centre + radius(rng) * direction();
   }
   c.regularization = VecX::Constant(1900, 1e-8);
-  const Result r = Compare(c, {.tolerance = 1e-6, .direct_below_pairs = 0}, &rng);
+  const Result r = Compare(c, {.tolerance = 1e-6, .direct_below_pairs = 0, .choose_by_cost = false}, &rng);
   EXPECT_LT(r.error, 1e-6);
   EXPECT_GT(r.stats.far_pairs, r.stats.near_pairs);
 }

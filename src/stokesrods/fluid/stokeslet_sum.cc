@@ -1,4 +1,36 @@
-// METHOD-COMMENT-PLACEHOLDER
+// Sums of regularized Stokeslets: the direct sum and a hierarchical-matrix (H-matrix) fast sum.
+//
+// METHOD. Fast sum = H-matrix of the 3T × 3S matrix [S_ε_s(x_t − y_s)]: kd cluster trees of
+// targets and sources (bisect the bounding box's longest side, ≤ 32 points per leaf); a block
+// (τ, σ) is far when max(diam τ, diam σ) ≤ η dist(τ, σ) (η = 1). Far blocks become U Vᵀ by adaptive
+// cross approximation (ACA, partial pivoting) of the *regularized* kernel itself, recompressed by
+// QR + SVD. So no Stokeslet expansion is used and there is no ε²/r² term to fold in or control: the
+// regularization, different ε per source, points on a line are all just entries of the matrix.
+// Near blocks are not stored: Apply sums them directly with the same vectorized loop as the direct
+// sum. Apply is deterministic (a fixed split of the blocks between threads).
+// ERROR CONTROL. ACA stops when |u_k||v_k| ≤ δ |U Vᵀ|_F and then checks one unused row per vector
+// component (without it, collinear points, whose components decouple, gave errors of 1e-2); the
+// SVD drops singular values whose tail is below δ; δ = 5 × tolerance. Measured errors in the norm of
+// the header (max over targets of |Δw| / Σ_s |S||g_s|), tests/fluid/stokeslet_sum_test.cc:
+//   tolerance        1e-4      1e-6      1e-8
+//   random cloud     1.1e-5    9.6e-8    5.1e-10
+//   10 helices       1.1e-5    1.9e-7    1.5e-9
+// MEASURED (AMD EPYC, 2 cores shared with other builds: ±30%; ms, one thread unless said).
+// The direct sum, vectorized (AVX-512/AVX2 clones chosen at run time, -fno-math-errno), costs
+// 1.7 ns per pair: Apply 1.4 (10 helices), 5.6 (20), 34 (50), 141 (100); Build ≈ 0.
+// The H-matrix on the lattice (forced), Build / Apply / factors:
+//   20 helices  1e-4: 281 / 6.8 / 34 MB   1e-6: 764 / 9.5 / 65 MB   1e-8: 1265 / 10.7 / 78 MB
+//   50 helices  1e-4: 1513 / 33 / 181 MB  1e-6, 1e-8: over the 300 MB budget
+//   100 helices 1e-4: 2 GB, 1e-6: 2.8 GB, 1e-8: 3.6 GB of factors (Build 11–40 s)
+// It never beats the vectorized direct sum here: on these thin helices 0.04 m apart 17–30 % of the
+// pairs are near at η = 1, and the ranks (max 17 / 36 / 57) of small blocks compress little. Hence
+// Build first estimates (rank 4 log10(1/tol), before any ACA, ≈ 1 ms) the memory and the Apply cost
+// and sums directly when the tree would not fit in `max_megabytes` or not pay off: on the lattice
+// MakeFastStokesletSum is then the direct sum (Apply 141 ms for 100 helices), not the goal of 10 ms.
+// Two threads: not measurable on the shared machine (load 4 on 2 cores; wall times were worse).
+// NEXT. The goal needs O(N) storage with nested bases: an FMM (four Laplace potentials with the
+// ε² dipole folded into ψ and the O(ε⁴/r⁴) rest controlled by a minimum far distance) or an H²/
+// bbFMM; at N = 12 800 its constants decide, so measure before choosing.
 #include "stokesrods/fluid/stokeslet_sum.h"
 
 #include <Eigen/Dense>
@@ -327,7 +359,7 @@ class FastStokesletSum final : public StokesletSum {
     src_.col(3) = eps2_;
     src_.rightCols<3>().setZero();
     Partition(0, 0);
-    if (!FillBlocks()) {  // the hierarchical matrix does not pay here: sum directly
+    if ((options_.choose_by_cost && !PaysOff()) || !FillBlocks()) {  // the hierarchical matrix does not pay here: sum directly
       use_direct_ = true;
       blocks_.clear();
       direct_.Build(sources, regularization, targets);
@@ -400,6 +432,22 @@ class FastStokesletSum final : public StokesletSum {
       Partition(tc.left, s);
       Partition(tc.right, s);
     }
+  }
+
+  /// A priori (before any compression): with a nominal rank k = 4 log10(1/tolerance) per far
+  /// block (the measured average is below it), do the factors fit in the memory budget and is an
+  /// Apply cheaper than the direct sum? Measured costs: a near pair (summed directly, vectorized)
+  /// ≈ 1.7 ns, a stored factor value ≈ 1 ns ≈ 0.6 pair.
+  bool PaysOff() const {
+    const double rank = 4.0 * std::log10(1.0 / options_.tolerance);
+    double factors = 0.0, near = 0.0;
+    for (const MatrixBlock& block : blocks_) {
+      const double m = ttree_.nodes[block.t].size(), n = stree_.nodes[block.s].size();
+      if (block.low_rank) factors += rank * 3.0 * (m + n);
+      if (!block.low_rank) near += m * n;
+    }
+    const double direct = static_cast<double>(num_sources_) * num_targets_;
+    return 8e-6 * factors <= options_.max_megabytes && near + 0.6 * factors < 0.7 * direct;
   }
 
   /// Compresses the admissible blocks; false when the factors would exceed the memory budget.

@@ -32,6 +32,9 @@ struct StokesletSumOptions {
   double admissibility = 1.0;
   /// Memory for the low-rank factors; above it Build gives up and the sum is direct [MB].
   double max_megabytes = 300.0;
+  /// Estimate the memory and the Apply cost of the hierarchical matrix before building it, and
+  /// sum directly when it would not fit or not pay off (false: always build it, for tests).
+  bool choose_by_cost = true;
 };
 
 /// What a Build produced (for tests and benchmarks).

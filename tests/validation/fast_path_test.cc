@@ -1,0 +1,131 @@
+// The fast hydrodynamic paths against the reference they replace, on whole time series:
+//   reference : dense 𝕄, the capacitance C = h𝕄 + S X by a fresh dense LU at every step;
+//   krylov    : dense 𝕄, C by GMRES preconditioned with a kept LU (the default below 600 nodes);
+//   matrix_free: 𝕄 never formed (exact near pairs, Gauss far field, Stokeslet sum), GMRES with
+//               per-rod block preconditioning (the default above 600 nodes).
+// All solve the same discrete equations; the fast ones stop GMRES at the Newton tolerance, and
+// matrix-free also carries the far-field tolerance (1e-8). Expected difference: the Newton
+// tolerance (1e-8 of the force scale) times the system's compliance, ~1e-9 of the rod length over
+// these runs; we allow 1e-6 of the helix radius on positions and 1e-6 of the largest clamp force
+// on forces, which is far below what any physical change makes (the regression test's changes)
+// and far above round-off.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "common/model_from_toml.h"
+#include "stokesrods/sim/integrator.h"
+#include "stokesrods/sim/observables.h"
+
+namespace stokesrods {
+namespace {
+
+using testing::ModelFromToml;
+
+struct Series {
+  std::vector<VecX> q;           // positions every `every` steps
+  std::vector<VecX> clamp_force; // per rod z force and torque, same times
+  double krylov_per_step = 0.0;
+};
+
+Series RunSeries(const std::string& toml, int steps, int every) {
+  const Model model = ModelFromToml(toml);
+  State state = MakeRestState(model);
+  Workspace ws(model);
+  Series s;
+  long krylov = 0;
+  const double h = 0.01;
+  for (int k = 1; k <= steps; ++k) {
+    const StepReport r = Step(model, h, &state, &ws);
+    EXPECT_TRUE(r.ok) << r.message;
+    if (!r.ok) break;
+    krylov += r.krylov_iterations;
+    if (k % every) continue;
+    s.q.push_back(state.q);
+    VecX loads(2 * model.rods.size());
+    for (int rod = 0; rod < static_cast<int>(model.rods.size()); ++rod) {
+      const ClampLoad load = CalcClampLoad(model, state, ws, rod);
+      loads(2 * rod) = load.force.z();
+      loads(2 * rod + 1) = load.torque_z;
+    }
+    s.clamp_force.push_back(loads);
+  }
+  s.krylov_per_step = static_cast<double>(krylov) / steps;
+  return s;
+}
+
+// Largest difference over the series: positions [m], clamp loads relative to the largest.
+void Compare(const Series& ref, const Series& fast, double radius, const char* name) {
+  ASSERT_EQ(ref.q.size(), fast.q.size());
+  double dq = 0.0, df = 0.0, scale = 0.0;
+  for (std::size_t i = 0; i < ref.q.size(); ++i) {
+    dq = std::max(dq, (ref.q[i] - fast.q[i]).cwiseAbs().maxCoeff());
+    df = std::max(df, (ref.clamp_force[i] - fast.clamp_force[i]).cwiseAbs().maxCoeff());
+    scale = std::max(scale, ref.clamp_force[i].cwiseAbs().maxCoeff());
+  }
+  std::printf("%s: max |Δq| = %.3e m (%.3e R), max |Δ clamp load| = %.3e of the largest; "
+              "GMRES products per step %.1f\n", name, dq, dq / radius, df / scale,
+              fast.krylov_per_step);
+  EXPECT_LT(dq, 1e-6 * radius);
+  EXPECT_LT(df, 1e-6 * scale);
+}
+
+std::string Fig1(const std::string& fluid, int nodes) {
+  // Paper Fig. 1 (two helices 3R apart, ω̄ = 320, contact on), 100 steps of 10 ms.
+  return R"(
+[run]
+duration = 1.0
+[fluid]
+model = "rss"
+)" + fluid + R"(
+[contact]
+enabled = true
+[[rods]]
+nodes = )" + std::to_string(nodes) + R"(
+omega_bar = 320
+[[rods]]
+nodes = )" + std::to_string(nodes) + R"(
+omega_bar = 320
+base = [0.03, 0.0, 0.0]
+)";
+}
+
+TEST(FastPath, Fig1TwoFlagella) {
+  const Series ref = RunSeries(Fig1("mobility = \"dense\"\nsolver = \"direct\"", 65), 60, 10);
+  Compare(ref, RunSeries(Fig1("mobility = \"dense\"\nsolver = \"krylov\"", 65), 60, 10), 0.01,
+          "Fig. 1, dense + GMRES");
+  Compare(ref, RunSeries(Fig1("mobility = \"matrix_free\"", 65), 60, 10), 0.01,
+          "Fig. 1, matrix-free + GMRES");
+}
+
+TEST(FastPath, TenFlagellaOnARing) {
+  // Ten helices (25 nodes each) on a ring with neighbouring bases 3R apart, 20 steps.
+  std::string toml = R"(
+[run]
+duration = 1.0
+[fluid]
+model = "rss"
+FLUID
+[contact]
+enabled = true
+)";
+  const double ring = 0.03 / (2.0 * std::sin(kPi / 10.0));
+  for (int k = 0; k < 10; ++k)
+    toml += "[[rods]]\nnodes = 25\nomega_bar = 320\nbase = [" +
+            std::to_string(ring * std::cos(2 * kPi * k / 10)) + ", " +
+            std::to_string(ring * std::sin(2 * kPi * k / 10)) + ", 0.0]\n";
+  auto with = [&](const std::string& fluid) {
+    std::string t = toml;
+    t.replace(t.find("FLUID"), 5, fluid);
+    return t;
+  };
+  const Series ref = RunSeries(with("mobility = \"dense\"\nsolver = \"direct\""), 20, 5);
+  Compare(ref, RunSeries(with("mobility = \"dense\"\nsolver = \"krylov\""), 20, 5), 0.01,
+          "10 flagella, dense + GMRES");
+  Compare(ref, RunSeries(with("mobility = \"matrix_free\""), 20, 5), 0.01,
+          "10 flagella, matrix-free + GMRES");
+}
+
+}  // namespace
+}  // namespace stokesrods
