@@ -224,15 +224,16 @@ NearFarSplit ChooseNearFarSplit(double tolerance) {
   //     e_n(δ) ≈ c_n δ^−(2n−1),   c_n ≈ 9.6e-3 · 13.5^−(n−2)
   // (c_2..c_6 = 9.6e-3, 7.6e-4, 5.6e-5, 3.9e-6, 2.7e-7). With a factor 2 of margin on c_n, the
   // near radius for n points is δ_n = (2 c_n / tolerance)^(1/(2n−1)); we take the fewest points
-  // whose near radius is at most 2.5 segment lengths (more points cost every product, a larger
-  // near zone costs exact integrals once per step and a denser correction).
+  // whose near radius is at most 12 segment lengths: every point costs every product (S × T
+  // kernel evaluations), while a larger near zone costs exact integrals once per step and 3×3
+  // blocks per near pair (tolerances 1e-9 … 1e-5 give 3 points; 1e-8: δ_3 = 10.8).
   NearFarSplit split;
   const double tol = std::max(tolerance, 1e-15);
   for (int n = 2; n <= 12; ++n) {
     const double c = 2.0 * 9.6e-3 * std::pow(13.5, -(n - 2.0));
     split.gauss_points = n;
     split.near_delta = std::max(1.0, std::pow(c / tol, 1.0 / (2.0 * n - 1.0)));
-    if (split.near_delta <= 2.5) break;
+    if (split.near_delta <= 12.0) break;
   }
   return split;
 }

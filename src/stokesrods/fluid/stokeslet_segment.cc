@@ -166,14 +166,28 @@ int FarFieldPointCount(double delta) {
 
 SegmentMobility FarFieldSegment(const Vec3& xa, const Vec3& v, double length, double eps,
                                 const Vec3& point, int points) {
+  // Σ_q w_q L φ(α_q) S_ε(r_q), φ = 1 − α (a) and α (b). Both are symmetric: accumulate the
+  // diagonal weight and the six entries of r rᵀ/R³ as scalars (no 3×3 temporaries per point).
   const GaussLegendreRule& rule = Rule(points);
-  SegmentMobility out;
-  for (size_t q = 0; q < static_cast<size_t>(rule.size); ++q) {
-    const double alpha = rule.node[q];
-    const Mat3 s = (rule.weight[q] * length) * RegularizedStokesletMatrix(point - xa - alpha * v, eps);
-    out.a += (1.0 - alpha) * s;
-    out.b += alpha * s;
+  const double eps2 = eps * eps;
+  const Vec3 r0 = point - xa;
+  double a[7] = {0, 0, 0, 0, 0, 0, 0}, b[7] = {0, 0, 0, 0, 0, 0, 0};  // diag, xx, xy, xz, yy, yz, zz
+  for (int q = 0; q < rule.size; ++q) {
+    const double alpha = rule.node[static_cast<size_t>(q)];
+    const double rx = r0.x() - alpha * v.x(), ry = r0.y() - alpha * v.y(), rz = r0.z() - alpha * v.z();
+    const double inv = 1.0 / std::sqrt(rx * rx + ry * ry + rz * rz + eps2);
+    const double w = rule.weight[static_cast<size_t>(q)] * length;
+    const double w3 = w * inv * inv * inv;
+    const double terms[7] = {w * inv + eps2 * w3, w3 * rx * rx, w3 * rx * ry, w3 * rx * rz,
+                             w3 * ry * ry,        w3 * ry * rz, w3 * rz * rz};
+    for (int k = 0; k < 7; ++k) {
+      a[k] += (1.0 - alpha) * terms[k];
+      b[k] += alpha * terms[k];
+    }
   }
+  SegmentMobility out;
+  out.a << a[0] + a[1], a[2], a[3], a[2], a[0] + a[4], a[5], a[3], a[5], a[0] + a[6];
+  out.b << b[0] + b[1], b[2], b[3], b[2], b[0] + b[4], b[5], b[3], b[5], b[0] + b[6];
   return out;
 }
 

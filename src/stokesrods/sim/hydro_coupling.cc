@@ -1,6 +1,7 @@
 #include "stokesrods/sim/hydro_coupling.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "stokesrods/common/assert.h"
 #include "stokesrods/sim/state.h"
@@ -116,9 +117,13 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
     for (int i = 0; i < n; ++i) sx.middleRows<3>(3 * i) = x.middleRows<3>(NodeDof(i));
   }
   if (block_preconditioner_) {
+    std::vector<MatX> blocks(model.rods.size());
     block_lu_.clear();
-    for (std::size_t r = 0; r < model.rods.size(); ++r)
-      block_lu_.emplace_back(h * mobility_->SelfBlock(static_cast<int>(r)) + sx_blocks_[r]);
+    for (std::size_t r = 0; r < model.rods.size(); ++r) {
+      blocks[r] = h * mobility_->SelfBlock(static_cast<int>(r)) + sx_blocks_[r];
+      block_lu_.emplace_back(blocks[r]);
+    }
+    BuildCoarseLevel(model, h, blocks);
   } else {
     MatX capacitance = h * *mobility_->matrix();
     for (std::size_t r = 0; r < model.rods.size(); ++r) {
@@ -143,17 +148,90 @@ void HydroCoupling::ApplyCapacitance(const Model& model, double h, const VecX& v
   }
 }
 
+void HydroCoupling::BuildCoarseLevel(const Model& model, double h,
+                                     const std::vector<MatX>& blocks) {
+  constexpr int kChunksPerRod = 4;
+  chunk_first_.clear();
+  std::vector<int> chunk_rod;
+  for (std::size_t r = 0; r < model.rods.size(); ++r) {
+    const int n = model.rods[r].num_nodes(), first = model.rods[r].node_offset;
+    const int chunks = std::min(kChunksPerRod, n);
+    for (int a = 0; a < chunks; ++a) {
+      chunk_first_.push_back(first + a * n / chunks);
+      chunk_rod.push_back(static_cast<int>(r));
+    }
+  }
+  const int m = model.num_nodes, nc = static_cast<int>(chunk_first_.size());
+  chunk_first_.push_back(m);
+  std::vector<int> node_rod(static_cast<size_t>(m));
+  for (std::size_t r = 0; r < model.rods.size(); ++r)
+    std::fill_n(node_rod.begin() + model.rods[r].node_offset, model.rods[r].num_nodes(),
+                static_cast<int>(r));
+  Matrix3X x(3, m);
+  VecX eps2(m);
+  for (std::size_t r = 0; r < model.rods.size(); ++r) {
+    x.middleCols(model.rods[r].node_offset, model.rods[r].num_nodes()) = positions_[r];
+    eps2.segment(model.rods[r].node_offset, model.rods[r].num_nodes()).setConstant(
+        std::pow(model.fluid.regularization * model.rods[r].radius, 2));
+  }
+  coarse_w_.setZero(3 * m, 3 * nc);
+  const double scale = h / (8.0 * kPi * model.fluid.viscosity);
+#pragma omp parallel for schedule(dynamic, 16)
+  for (int i = 0; i < m; ++i) {
+    const int rod_i = node_rod[static_cast<size_t>(i)];
+    const int first_i = model.rods[static_cast<size_t>(rod_i)].node_offset;
+    for (int b = 0; b < nc; ++b) {
+      const int rod_b = chunk_rod[static_cast<size_t>(b)];
+      Mat3 sum = Mat3::Zero();
+      if (rod_b == rod_i) {  // within the rod: the exact block, columns of the chunk summed
+        for (int j = chunk_first_[static_cast<size_t>(b)]; j < chunk_first_[static_cast<size_t>(b) + 1]; ++j)
+          sum += blocks[static_cast<size_t>(rod_i)].block<3, 3>(3 * (i - first_i), 3 * (j - first_i));
+      } else {               // between rods: a point Stokeslet per node (the nodal force F_j)
+        double sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0, diag = 0;
+        for (int j = chunk_first_[static_cast<size_t>(b)]; j < chunk_first_[static_cast<size_t>(b) + 1]; ++j) {
+          const double rx = x(0, i) - x(0, j), ry = x(1, i) - x(1, j), rz = x(2, i) - x(2, j);
+          const double e2 = eps2(j);
+          const double inv = 1.0 / std::sqrt(rx * rx + ry * ry + rz * rz + e2);
+          const double inv3 = inv * inv * inv;
+          diag += inv + e2 * inv3;
+          sxx += rx * rx * inv3; sxy += rx * ry * inv3; sxz += rx * rz * inv3;
+          syy += ry * ry * inv3; syz += ry * rz * inv3; szz += rz * rz * inv3;
+        }
+        sum << diag + sxx, sxy, sxz, sxy, diag + syy, syz, sxz, syz, diag + szz;
+        sum *= scale;
+      }
+      coarse_w_.block<3, 3>(3 * i, 3 * b) = sum;
+    }
+  }
+  MatX e = MatX::Zero(3 * nc, 3 * nc);  // E = Zᵀ W: rows of W summed over each chunk
+  for (int a = 0; a < nc; ++a)
+    for (int i = chunk_first_[static_cast<size_t>(a)]; i < chunk_first_[static_cast<size_t>(a) + 1]; ++i)
+      e.middleRows<3>(3 * a) += coarse_w_.middleRows<3>(3 * i);
+  coarse_lu_.compute(e);
+}
+
 void HydroCoupling::Precondition(const VecX& v, VecX* out) const {
   if (!block_preconditioner_) {
     *out = capacitance_lu_.solve(v);
     return;
   }
+  // Coarse: c = E⁻¹ Zᵀ v; then the blocks on what the coarse correction leaves, y = Zc + D⁻¹(v − Wc).
+  const int nc = static_cast<int>(chunk_first_.size()) - 1;
+  VecX zv = VecX::Zero(3 * nc);
+  for (int a = 0; a < nc; ++a)
+    for (int i = chunk_first_[static_cast<size_t>(a)]; i < chunk_first_[static_cast<size_t>(a) + 1]; ++i)
+      zv.segment<3>(3 * a) += v.segment<3>(3 * i);
+  const VecX coarse = coarse_lu_.solve(zv);
+  const VecX rest = v - coarse_w_ * coarse;
   out->resize(v.size());
   for (int r = 0; r < mobility_->num_rods(); ++r) {
     const int first = 3 * mobility_->node_offset(r);
     const int n = 3 * (mobility_->node_offset(r + 1) - mobility_->node_offset(r));
-    out->segment(first, n) = block_lu_[static_cast<size_t>(r)].solve(v.segment(first, n));
+    out->segment(first, n) = block_lu_[static_cast<size_t>(r)].solve(rest.segment(first, n));
   }
+  for (int a = 0; a < nc; ++a)
+    for (int i = chunk_first_[static_cast<size_t>(a)]; i < chunk_first_[static_cast<size_t>(a) + 1]; ++i)
+      out->segment<3>(3 * i) += coarse.segment<3>(3 * a);
 }
 
 HydroSolveReport HydroCoupling::SolveNewtonSystem(const Model& model,

@@ -11,8 +11,15 @@
 // C of size 3M and never 𝕄⁻¹. The capacitance C is solved
 //   direct: by a dense LU of C at the current 𝕄 (the reference, refactorized whenever 𝕄 or B is),
 //   krylov: by GMRES with products h 𝕄 v + S X v (𝕄 matrix-free or dense) and a preconditioner
-//           kept across steps: the LU of the whole C (dense 𝕄) or of its per-rod diagonal blocks
-//           h 𝕄_kk + S_k X_k (matrix-free), rebuilt with the Newton factors or when GMRES slows.
+//           kept across steps, rebuilt with the Newton factors or when GMRES slows:
+//           dense 𝕄: the LU of the whole C;
+//           matrix-free: two levels. Coarse: per rod, K chunks of consecutive nodes with a
+//           uniform force each (columns Z, 3K per rod), the coarse operator E = Zᵀ W with
+//           W ≈ C Z (within a rod from the exact blocks, between rods from point Stokeslets
+//           node to node, O(M²) once per rebuild). Fine: the LU of the per-rod blocks
+//           D_k = h 𝕄_kk + S_k X_k. One application: c = E⁻¹ Zᵀ r, y = Z c + D⁻¹ (r − W c).
+//           Block Jacobi alone misses the collective flow of many rods (GMRES then needs
+//           5–6× more products); the coarse level carries it.
 // Since r_u is linear in (q, f), after a full Newton step it is the GMRES residual / h; along a
 // damped step it changes linearly, so line-search trials need no product with 𝕄.
 #pragma once
@@ -90,6 +97,10 @@ class HydroCoupling {
   // Direct: the LU of C; krylov: the preconditioner (the LU of C, or of its diagonal blocks).
   Eigen::PartialPivLU<MatX> capacitance_lu_;
   std::vector<Eigen::PartialPivLU<MatX>> block_lu_;
+  void BuildCoarseLevel(const Model& model, double h, const std::vector<MatX>& blocks);
+  std::vector<int> chunk_first_;   ///< first global node of each chunk; back() = M
+  MatX coarse_w_;                  ///< W ≈ C Z (3M × 3 chunks)
+  Eigen::PartialPivLU<MatX> coarse_lu_;  ///< of E = Zᵀ W
   bool block_preconditioner_ = false;
   int iterations_after_refresh_ = -1;
   bool wants_refresh_ = false;

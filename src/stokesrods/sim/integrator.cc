@@ -208,6 +208,18 @@ NewtonReport SolveNewton(const Model& model, const State& start, double h, Works
       }
       Evaluate(model, start, h, ws->q_try, saddle ? ws->hydro_force_try : ws->hydro_force, false,
                ws, &ws->frames_try, &ws->residual_try);
+      // A full step that already meets the tolerance is accepted without its simplified
+      // correction (one linear solve less at the end of each step).
+      if (alpha == 1.0 &&
+          norm_of(ws->residual_try, ws->velocity_residual_try) <=
+              std::max(model.newton.tolerance *
+                           std::max(model.force_scale, ResidualNorm(model, ws->force)),
+                       RoundOffFloor(model, ws->q_try))) {
+        simplified_norm = 0.0;
+        ws->simplified.setZero();
+        if (saddle) ws->simplified_hydro_delta.setZero(), ws->simplified_hydro_rate.setZero();
+        break;
+      }
       report.krylov_iterations += NewtonCorrection(
           model, h, ws->residual_try, ws->velocity_residual_try, ws, &ws->simplified,
           &ws->simplified_hydro_delta, &ws->simplified_hydro_rate, velocity_tolerance);
