@@ -24,6 +24,9 @@ struct FluidParams {
   FluidModel model = FluidModel::kRss;
   double viscosity = 1.0;       ///< μ [Pa·s]
   double regularization = 1.02; ///< RSS blob size ε in units of the rod radius r0 [–]
+  /// RSS assembly: relative error allowed on each far segment–node interaction (0: round-off,
+  /// the reference; see StokesletSegment) [–].
+  double far_field_tolerance = 0.0;
 };
 
 /// Geometry of one rod as the fluid sees it.

@@ -126,11 +126,9 @@ void MatrixFreeRssMobility::Update(const std::vector<HydroRod>& rods) {
 // longest segment, so that every segment within the near radius of a target has its midpoint in
 // the 27 cells around the target.
 void MatrixFreeRssMobility::FindNearPairs(const Matrix3X& targets) {
-  double longest = 0.0, max_eps = 0.0;
-  for (const Segment& s : segments_) {
+  double longest = 0.0;
+  for (const Segment& s : segments_)
     longest = std::max(longest, (nodes_.col(s.a + 1) - nodes_.col(s.a)).norm());
-    max_eps = std::max(max_eps, s.eps);
-  }
   const double reach = split_.near_delta * longest;  // d < δ_near L ≤ this
   const double cell = reach + 0.5 * longest;
   auto key = [&](const Vec3& p, int dx, int dy, int dz) {
@@ -146,14 +144,20 @@ void MatrixFreeRssMobility::FindNearPairs(const Matrix3X& targets) {
   }
   const double scale = 1.0 / (8.0 * kPi * params_.viscosity);
   const int m = static_cast<int>(targets.cols());
-  near_start_.assign(1, 0);
-  near_source_.clear();
-  near_block_.clear();
-  std::vector<int> candidates;
-  std::unordered_map<int, Mat3> blocks;  // per target: source node → block
+  // Per target, its (source node, block) list; targets in parallel, then concatenated in order.
+  std::vector<std::vector<std::pair<int, Mat3>>> per_target(static_cast<size_t>(m));
+#pragma omp parallel for schedule(dynamic, 16)
   for (int t = 0; t < m; ++t) {
     const Vec3 p = targets.col(t);
-    blocks.clear();
+    std::vector<std::pair<int, Mat3>>& blocks = per_target[static_cast<size_t>(t)];
+    auto add = [&](int node, const Mat3& block) {
+      for (auto& [n, b] : blocks)
+        if (n == node) {
+          b += scale * inverse_voronoi_(node) * block;
+          return;
+        }
+      blocks.emplace_back(node, scale * inverse_voronoi_(node) * block);
+    };
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dz = -1; dz <= 1; ++dz) {
@@ -166,24 +170,24 @@ void MatrixFreeRssMobility::FindNearPairs(const Matrix3X& targets) {
             const double alpha = std::clamp((p - xa).dot(v) / v.squaredNorm(), 0.0, 1.0);
             const double d2 = (p - xa - alpha * v).squaredNorm() + seg.eps * seg.eps;
             if (d2 >= split_.near_delta * split_.near_delta * v.squaredNorm()) continue;
-            const SegmentMobility exact = StokesletSegment(xa, xb, seg.eps, p);
+            const SegmentMobility exact = StokesletSegment(xa, xb, seg.eps, p);  // round-off
             const SegmentMobility rule =
                 StokesletSegmentGauss(xa, xb, seg.eps, p, split_.gauss_points);
-            auto add = [&](int node, const Mat3& block) {
-              auto [slot, inserted] = blocks.try_emplace(node, Mat3::Zero());
-              slot->second += scale * inverse_voronoi_(node) * block;
-            };
             add(seg.a, exact.a - rule.a);
             add(seg.a + 1, exact.b - rule.b);
           }
         }
+  }
+  near_start_.assign(1, 0);
+  near_source_.clear();
+  near_block_.clear();
+  for (const auto& blocks : per_target) {
     for (const auto& [node, block] : blocks) {
       near_source_.push_back(node);
       near_block_.push_back(block);
     }
     near_start_.push_back(static_cast<int>(near_source_.size()));
   }
-  (void)max_eps;
 }
 
 void MatrixFreeRssMobility::Apply(const VecX& force, VecX* velocity) const {
@@ -222,17 +226,17 @@ NearFarSplit ChooseNearFarSplit(double tolerance) {
   // δ = √(d² + ε²)/L: measured worst over random points and ε ∈ {0.05, 0.3} L (the table in
   // docs/performance.md; tests/fluid/mobility_operator_test.cc checks it), it falls like
   //     e_n(δ) ≈ c_n δ^−(2n−1),   c_n ≈ 9.6e-3 · 13.5^−(n−2)
-  // (c_2..c_6 = 9.6e-3, 7.6e-4, 5.6e-5, 3.9e-6, 2.7e-7). With a factor 2 of margin on c_n, the
-  // near radius for n points is δ_n = (2 c_n / tolerance)^(1/(2n−1)); we take the fewest points
+  // (c_2..c_6 = 9.6e-3, 7.6e-4, 5.6e-5, 3.9e-6, 2.7e-7). With a factor 2 of margin on c_n
+  // (GaussRuleError), the near radius for n points is δ_n = (2 c_n / tolerance)^(1/(2n−1)); we take the fewest points
   // whose near radius is at most 12 segment lengths: every point costs every product (S × T
   // kernel evaluations), while a larger near zone costs exact integrals once per step and 3×3
   // blocks per near pair (tolerances 1e-9 … 1e-5 give 3 points; 1e-8: δ_3 = 10.8).
   NearFarSplit split;
   const double tol = std::max(tolerance, 1e-15);
   for (int n = 2; n <= 12; ++n) {
-    const double c = 2.0 * 9.6e-3 * std::pow(13.5, -(n - 2.0));
-    split.gauss_points = n;
-    split.near_delta = std::max(1.0, std::pow(c / tol, 1.0 / (2.0 * n - 1.0)));
+    split.gauss_points = n;  // GaussRuleError(n, δ_n) = tol
+    split.near_delta =
+        std::max(1.0, std::pow(GaussRuleError(n, 1.0) / tol, 1.0 / (2.0 * n - 1.0)));
     if (split.near_delta <= 12.0) break;
   }
   return split;

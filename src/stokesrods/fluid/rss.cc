@@ -1,5 +1,7 @@
 #include "stokesrods/fluid/rss.h"
 
+#include <vector>
+
 #include "stokesrods/common/assert.h"
 #include "stokesrods/fluid/stokeslet_segment.h"
 
@@ -10,20 +12,27 @@ void AssembleRssDensityMobility(const FluidParams& params, const std::vector<Hyd
   const Eigen::Index total = TotalNodes(rods);
   density_mobility->setZero(3 * total, 3 * total);
   const double scale = 1.0 / (8.0 * kPi * params.viscosity);
-  Eigen::Index target = 0;  // global index of the collocation node
-  for (const HydroRod& target_rod : rods) {
-    for (Eigen::Index i = 0; i < target_rod.x->cols(); ++i, ++target) {
-      const Vec3 point = target_rod.x->col(i);
-      Eigen::Index source = 0;  // global index of the source rod's first node
-      for (const HydroRod& rod : rods) {
-        const double eps = params.regularization * rod.radius;
-        for (Eigen::Index j = 0; j + 1 < rod.x->cols(); ++j) {
-          const SegmentMobility s = StokesletSegment(rod.x->col(j), rod.x->col(j + 1), eps, point);
-          density_mobility->block<3, 3>(3 * target, 3 * (source + j)) += scale * s.a;
-          density_mobility->block<3, 3>(3 * target, 3 * (source + j + 1)) += scale * s.b;
-        }
-        source += rod.x->cols();
+  std::vector<const Matrix3X*> node_rod;  // rod of each global node, and its column
+  std::vector<Eigen::Index> node_col;
+  for (const HydroRod& rod : rods)
+    for (Eigen::Index i = 0; i < rod.x->cols(); ++i) {
+      node_rod.push_back(rod.x);
+      node_col.push_back(i);
+    }
+  // Each target writes its own three rows: targets in parallel.
+#pragma omp parallel for schedule(dynamic, 8)
+  for (Eigen::Index target = 0; target < total; ++target) {
+    const Vec3 point = node_rod[static_cast<size_t>(target)]->col(node_col[static_cast<size_t>(target)]);
+    Eigen::Index source = 0;  // global index of the source rod's first node
+    for (const HydroRod& rod : rods) {
+      const double eps = params.regularization * rod.radius;
+      for (Eigen::Index j = 0; j + 1 < rod.x->cols(); ++j) {
+        const SegmentMobility s = StokesletSegment(rod.x->col(j), rod.x->col(j + 1), eps, point,
+                                                   params.far_field_tolerance);
+        density_mobility->block<3, 3>(3 * target, 3 * (source + j)) += scale * s.a;
+        density_mobility->block<3, 3>(3 * target, 3 * (source + j + 1)) += scale * s.b;
       }
+      source += rod.x->cols();
     }
   }
 }

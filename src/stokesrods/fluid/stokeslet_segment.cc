@@ -223,8 +223,12 @@ Mat3 StokesletMatrix(const Vec3& r) {
   return inv_r * Mat3::Identity() + (inv_r * inv_r * inv_r) * (r * r.transpose());
 }
 
+double GaussRuleError(int n, double delta) {
+  return 2.0 * 9.6e-3 * std::pow(13.5, -(n - 2.0)) * std::pow(delta, -(2.0 * n - 1.0));
+}
+
 SegmentMobility StokesletSegment(const Vec3& xa, const Vec3& xb, double regularization,
-                                 const Vec3& point) {
+                                 const Vec3& point, double tolerance) {
   const Vec3 v = xb - xa;
   const double l2 = v.squaredNorm();
   SR_ASSERT(l2 > 0.0, "Stokeslet segment of zero length");
@@ -238,7 +242,25 @@ SegmentMobility StokesletSegment(const Vec3& xa, const Vec3& xb, double regulari
   const double distance2 = r_perp.squaredNorm() + along * along * l2;
   if (distance2 + eps * eps >= l2) {
     const double delta = std::sqrt((distance2 + eps * eps) / l2);
-    return FarFieldSegment(xa, v, length, eps, point, FarFieldPointCount(delta));
+    int points = FarFieldPointCount(delta);
+    if (tolerance > 0.0) {
+      // δ above which n points meet the tolerance, GaussRuleError(n, δ) = tolerance, tabulated
+      // once per tolerance (per thread: the assembly runs in parallel).
+      thread_local double table_tolerance = -1.0;
+      thread_local std::array<double, kFarFieldPoints + 1> min_delta{};
+      if (tolerance != table_tolerance) {
+        for (int n = 2; n <= kFarFieldPoints; ++n)
+          min_delta[static_cast<size_t>(n)] =
+              std::pow(GaussRuleError(n, 1.0) / tolerance, 1.0 / (2.0 * n - 1.0));
+        table_tolerance = tolerance;
+      }
+      for (int n = 2; n < points; ++n)
+        if (delta >= min_delta[static_cast<size_t>(n)]) {
+          points = n;
+          break;
+        }
+    }
+    return FarFieldSegment(xa, v, length, eps, point, points);
   }
 
   const double d = std::sqrt(r_perp.squaredNorm() + eps * eps);

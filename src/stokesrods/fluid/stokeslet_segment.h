@@ -35,8 +35,16 @@ Mat3 StokesletMatrix(const Vec3& r);
 /// ρ ≥ 2 + √5 and a 20-point Gauss–Legendre rule is exact to rounding (error ∝ ρ^−40 < 1e-25).
 /// Relative error (Frobenius) below 1e-12 everywhere tested, worst 2.5e-13, the reference's own
 /// noise level (tests/fluid/stokeslet_segment_test.cc).
+/// With `tolerance` > 0 the far field may use fewer points: the fewest whose measured error
+/// bound GaussRuleError(n, δ) is below `tolerance` relative to |A| (never more than the
+/// round-off rule; the near closed forms are unchanged).
 SegmentMobility StokesletSegment(const Vec3& xa, const Vec3& xb, double regularization,
-                                 const Vec3& point);
+                                 const Vec3& point, double tolerance = 0.0);
+
+/// Bound on the relative error (Frobenius, of (A_a, A_b)) of the n-point Gauss–Legendre rule on
+/// one segment at δ = √(d² + ε²)/L ≥ 1: twice the measured worst case e_n(δ) ≈ c_n δ^−(2n−1),
+/// c_n ≈ 9.6e-3 · 13.5^−(n−2) (calibration in tests/fluid/mobility_operator_test.cc).
+double GaussRuleError(int n, double delta);
 
 /// A_a, A_b of eq. 8 by an n-point Gauss–Legendre rule (1 ≤ n ≤ 20): exact to rounding only far
 /// from the segment (see StokesletSegment); the far field of the matrix-free mobility.

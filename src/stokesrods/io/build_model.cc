@@ -172,13 +172,18 @@ Model BuildModel(const Config& config) {
     model.rods.push_back(std::move(rod));
   }
   FinalizeLayout(&model);
-  // "auto": the dense 𝕄 (3M × 3M) while it is small; above 600 nodes (a 14 MB matrix whose
-  // assembly and LU cost more per step than the matrix-free products) the matrix-free operator.
+  // "auto": the dense 𝕄 (3M × 3M) while it is small; above 1000 nodes (a 72 MB matrix, and a
+  // capacitance LU of 3000²) the matrix-free operator. Measured crossover (docs/performance.md):
+  // 10 helices (650 nodes) 111 ms dense against 124 ms matrix-free per step; 20 helices (1300)
+  // 441 against 464 ms, with 8× less memory matrix-free.
   const bool matrix_free =
       config.fluid.mobility == "matrix_free" ||
       (config.fluid.mobility == "auto" && model.fluid.model == FluidModel::kRss &&
-       model.num_nodes > 600 && config.fluid.solver != "direct");
+       model.num_nodes > 1000 && config.fluid.solver != "direct");
   model.hydro.mobility.kind = matrix_free ? MobilityKind::kMatrixFree : MobilityKind::kDense;
+  // The dense 𝕄 of the Krylov path is assembled to the far-field tolerance (fewer Gauss points
+  // far away); the direct solver, the reference, keeps round-off.
+  if (config.fluid.solver == "krylov") model.fluid.far_field_tolerance = config.fluid.far_field_tolerance;
 
   CheckFluidModel(config, &model);
 

@@ -30,11 +30,16 @@ std::vector<HydroRod> MakeHydroRods(const Model& model, const std::vector<Matrix
   return rods;
 }
 
+constexpr int kFullLuBelow = 3000;
+
 void HydroCoupling::Init(const Model& model) {
   mobility_ = MakeMobilityOperator(model.fluid, model.hydro.mobility);
   krylov_ = model.hydro.solver == HydroSolver::kKrylov;
   explicit_ = model.coupling == FluidCoupling::kExplicit;
-  block_preconditioner_ = mobility_->matrix() == nullptr;
+  // The whole capacitance's LU while it is small; above 3M = 3000 its O((3M)³) rebuilds cost more
+  // than the extra GMRES products of the two-level preconditioner (docs/performance.md).
+  block_preconditioner_ =
+      mobility_->matrix() == nullptr || (krylov_ && 3 * model.num_nodes > kFullLuBelow);
   SR_ASSERT(krylov_ || !block_preconditioner_, "the direct solve needs a dense mobility");
 }
 
