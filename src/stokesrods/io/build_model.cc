@@ -135,6 +135,8 @@ Model BuildModel(const Config& config) {
       config.fluid.solver == "direct" ? HydroSolver::kDirect : HydroSolver::kKrylov;
   model.hydro.krylov_tolerance = config.fluid.krylov_tolerance;
   model.hydro.mobility.tolerance = config.fluid.far_field_tolerance;
+  model.integrator =
+      config.run.integrator == "bdf2" ? TimeIntegrator::kBdf2 : TimeIntegrator::kEuler;
   model.contact = config.contact.enabled;
   model.gravity = config.gravity.acceleration;
   model.damping = config.solver.damping;

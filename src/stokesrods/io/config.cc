@@ -25,6 +25,7 @@ void VisitFields(RunConfig& c, V& v) {
   v("duration", c.duration);
   v("t_bar_end", c.t_bar_end);
   v("time_step", c.time_step);
+  v("integrator", c.integrator);
   v("output_interval", c.output_interval);
   v("frames", c.frames);
   v("checkpoint_interval", c.checkpoint_interval);

@@ -32,6 +32,7 @@ struct RunConfig {
   std::optional<double> duration;         ///< [s]
   std::optional<double> t_bar_end;        ///< normalized end time (paper eq. 24b)
   double time_step = 1e-3;                ///< [s]
+  std::string integrator = "euler";       ///< "euler" (paper eq. 22) | "bdf2" (second order)
   std::optional<double> output_interval;  ///< [s], default: 1/100 of the run
   bool frames = true;
   std::optional<double> checkpoint_interval;  ///< [s], default: 1/10 of the run

@@ -90,6 +90,10 @@ void ValidateConfig(Config* config) {
   const Checker c{config->file};
   RunConfig& run = config->run;
   c.OneOf("run.mode", run.mode, {"dynamic", "static"});
+  c.OneOf("run.integrator", run.integrator, {"euler", "bdf2"});
+  if (run.integrator == "bdf2" && config->fluid.coupling == "explicit")
+    throw ConfigError(c.file, "run.integrator",
+                      "\"bdf2\" needs fluid.coupling = \"implicit\" (the explicit drag is first order)");
   if (run.name.empty()) throw ConfigError(c.file, "run.name", "must not be empty");
   if (run.output.empty()) run.output = "out/" + run.name;
   c.Positive("run.time_step", run.time_step);

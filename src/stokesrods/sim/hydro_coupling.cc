@@ -51,6 +51,7 @@ HydroSolveReport HydroCoupling::Prepare(const Model& model, const VecX& q_start,
     positions_[static_cast<size_t>(r)] = RodPositions(model, r, q_start);
   mobility_->Update(MakeHydroRods(model, positions_));
   mobility_changed_ = true;
+  ++preconditioner_age_;
   HydroSolveReport report;
   if (!explicit_) return report;
   // The explicit drag: 𝕄 f = −U(t_k).
@@ -102,55 +103,82 @@ void HydroCoupling::VelocityResidual(const Model& model, const VecX& q, const Ve
 bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
                                           std::vector<BandedMatrix>* jacobian) {
   SR_ASSERT(!explicit_, "the capacitance solve is for the implicit coupling");
-  x_blocks_.resize(model.rods.size());
-  sx_blocks_.resize(model.rods.size());
-  for (std::size_t r = 0; r < model.rods.size(); ++r) {
-    const RodModel& rod = model.rods[r];
-    const int n = rod.num_nodes();
-    BandedMatrix& b = (*jacobian)[r];
+  for (BandedMatrix& b : *jacobian)
     if (!b.Factorize()) return false;
-    // X_k = B_k⁻¹ S_kᵀ: a unit right-hand side per free position DOF (fixed ones stay zero).
-    MatX& x = x_blocks_[r];
-    x = MatX::Zero(rod.num_dofs(), 3 * n);
-    for (int i = 0; i < n; ++i)
-      for (int c = 0; c < 3; ++c)
-        if (!std::binary_search(rod.fixed_dofs.begin(), rod.fixed_dofs.end(), NodeDof(i) + c))
-          x(NodeDof(i) + c, 3 * i + c) = 1.0;
-    b.Solve(&x);
-    MatX& sx = sx_blocks_[r];
-    sx.resize(3 * n, 3 * n);
-    for (int i = 0; i < n; ++i) sx.middleRows<3>(3 * i) = x.middleRows<3>(NodeDof(i));
-  }
-  if (block_preconditioner_) {
-    std::vector<MatX> blocks(model.rods.size());
-    block_lu_.clear();
-    for (std::size_t r = 0; r < model.rods.size(); ++r) {
-      blocks[r] = h * mobility_->SelfBlock(static_cast<int>(r)) + sx_blocks_[r];
-      block_lu_.emplace_back(blocks[r]);
+  jacobian_ = jacobian;
+  // The Krylov preconditioner (O((3M)³) for the full LU) is kept while it serves: rebuilt when
+  // GMRES slowed, h changed, or it is jacobian_max_age steps old; X and S X are always new.
+  const bool rebuild = !krylov_ || !have_preconditioner_ || wants_refresh_ ||
+                       preconditioner_h_ != h ||
+                       preconditioner_age_ >= std::max(1, model.newton.jacobian_max_age);
+  if (rebuild) {
+    have_preconditioner_ = true;
+    preconditioner_h_ = h;
+    preconditioner_age_ = 0;
+    iterations_after_refresh_ = -1;
+    BuildSchurBlocks(model);
+    if (block_preconditioner_) {
+      std::vector<MatX> blocks(model.rods.size());
+      block_lu_.clear();
+      for (std::size_t r = 0; r < model.rods.size(); ++r) {
+        blocks[r] = h * mobility_->SelfBlock(static_cast<int>(r)) + sx_blocks_[r];
+        block_lu_.emplace_back(blocks[r]);
+      }
+      BuildCoarseLevel(model, h, blocks);
+    } else {
+      MatX capacitance = h * *mobility_->matrix();
+      for (std::size_t r = 0; r < model.rods.size(); ++r) {
+        const int first = 3 * model.rods[r].node_offset, n = static_cast<int>(sx_blocks_[r].rows());
+        capacitance.block(first, first, n, n) += sx_blocks_[r];
+      }
+      capacitance_lu_.compute(capacitance);
     }
-    BuildCoarseLevel(model, h, blocks);
-  } else {
-    MatX capacitance = h * *mobility_->matrix();
-    for (std::size_t r = 0; r < model.rods.size(); ++r) {
-      const int first = 3 * model.rods[r].node_offset, n = static_cast<int>(sx_blocks_[r].rows());
-      capacitance.block(first, first, n, n) += sx_blocks_[r];
-    }
-    capacitance_lu_.compute(capacitance);
   }
   mobility_changed_ = false;
-  iterations_after_refresh_ = -1;
   wants_refresh_ = false;
   return true;
 }
 
+void HydroCoupling::BuildSchurBlocks(const Model& model) {
+  sx_blocks_.resize(model.rods.size());
+  for (std::size_t r = 0; r < model.rods.size(); ++r) {
+    const RodModel& rod = model.rods[r];
+    const int n = rod.num_nodes();
+    // X_k = B_k⁻¹ S_kᵀ: a unit right-hand side per free position DOF (fixed ones stay zero).
+    MatX x = MatX::Zero(rod.num_dofs(), 3 * n);
+    for (int i = 0; i < n; ++i)
+      for (int c = 0; c < 3; ++c)
+        if (!std::binary_search(rod.fixed_dofs.begin(), rod.fixed_dofs.end(), NodeDof(i) + c))
+          x(NodeDof(i) + c, 3 * i + c) = 1.0;
+    (*jacobian_)[r].Solve(&x);
+    MatX& sx = sx_blocks_[r];
+    sx.resize(3 * n, 3 * n);
+    for (int i = 0; i < n; ++i) sx.middleRows<3>(3 * i) = x.middleRows<3>(NodeDof(i));
+  }
+}
+
+void HydroCoupling::SolveBanded(const Model& model, const VecX& nodal, const VecX* dofs,
+                                VecX* out) const {
+  // out = B⁻¹ (Sᵀ nodal + dofs): nodal forces on the free position DOFs, plus a DOF vector.
+  if (dofs) *out = *dofs; else out->setZero(model.num_dofs);
+  for (const RodModel& rod : model.rods) {
+    for (int i = 0; i < rod.num_nodes(); ++i)
+      out->segment<3>(rod.dof_offset + NodeDof(i)) += nodal.segment<3>(3 * (rod.node_offset + i));
+    for (int k : rod.fixed_dofs) (*out)(rod.dof_offset + k) = dofs ? (*dofs)(rod.dof_offset + k) : 0.0;
+  }
+  for (std::size_t r = 0; r < model.rods.size(); ++r)
+    (*jacobian_)[r].Solve(out->data() + model.rods[r].dof_offset, 1);
+}
+
 void HydroCoupling::ApplyCapacitance(const Model& model, double h, const VecX& v,
                                      VecX* out) const {
+  // C v = h 𝕄 v + S B⁻¹ Sᵀ v: the elastic part by a banded solve per rod (O(N), no dense S X).
   mobility_->Apply(v, out);
   *out *= h;
-  for (std::size_t r = 0; r < model.rods.size(); ++r) {
-    const int first = 3 * model.rods[r].node_offset, n = static_cast<int>(sx_blocks_[r].rows());
-    out->segment(first, n).noalias() += sx_blocks_[r] * v.segment(first, n);
-  }
+  SolveBanded(model, v, nullptr, &scratch_dofs_);
+  for (const RodModel& rod : model.rods)
+    for (int i = 0; i < rod.num_nodes(); ++i)
+      out->segment<3>(3 * (rod.node_offset + i)) += scratch_dofs_.segment<3>(rod.dof_offset + NodeDof(i));
 }
 
 void HydroCoupling::BuildCoarseLevel(const Model& model, double h,
@@ -280,12 +308,9 @@ HydroSolveReport HydroCoupling::SolveNewtonSystem(const Model& model,
     if (iterations_after_refresh_ < 0) iterations_after_refresh_ = g.iterations;
     wants_refresh_ = g.iterations > 2 * iterations_after_refresh_ + 2;
   }
-  // δq = y + X δf;  du = S δq/h + 𝕄 δf = (S y + C δf)/h.
-  for (std::size_t r = 0; r < model.rods.size(); ++r) {
-    const RodModel& rod = model.rods[r];
-    dq->segment(rod.dof_offset, rod.num_dofs()).noalias() +=
-        x_blocks_[r] * df->segment(3 * rod.node_offset, 3 * rod.num_nodes());
-  }
+  // δq = y + X δf = y + B⁻¹ Sᵀ δf;  du = S δq/h + 𝕄 δf = (S y + C δf)/h.
+  SolveBanded(model, *df, nullptr, &scratch_dofs_);
+  *dq += scratch_dofs_;
   *du = (sy + cdf) / h;
   return report;
 }

@@ -84,6 +84,10 @@ class HydroCoupling {
 
  private:
   void ApplyCapacitance(const Model& model, double h, const VecX& v, VecX* out) const;
+  void BuildSchurBlocks(const Model& model);
+  void SolveBanded(const Model& model, const VecX& nodal, const VecX* dofs, VecX* out) const;
+  const std::vector<BandedMatrix>* jacobian_ = nullptr;  ///< the factorized B of the last rebuild
+  mutable VecX scratch_dofs_;
   void Precondition(const VecX& v, VecX* out) const;
 
   std::unique_ptr<MobilityOperator> mobility_;
@@ -92,8 +96,7 @@ class HydroCoupling {
   bool explicit_ = false;
   bool mobility_changed_ = true;   ///< 𝕄 was updated since the capacitance was factorized
   VecX explicit_force_;            ///< 3M
-  std::vector<MatX> x_blocks_;     ///< X_k = B_k⁻¹ S_kᵀ per rod (n_k × 3N_k)
-  std::vector<MatX> sx_blocks_;    ///< S_k X_k (3N_k × 3N_k)
+  std::vector<MatX> sx_blocks_;    ///< S_k B_k⁻¹ S_kᵀ (3N_k × 3N_k), for the preconditioner only
   // Direct: the LU of C; krylov: the preconditioner (the LU of C, or of its diagonal blocks).
   Eigen::PartialPivLU<MatX> capacitance_lu_;
   std::vector<Eigen::PartialPivLU<MatX>> block_lu_;
@@ -103,6 +106,9 @@ class HydroCoupling {
   Eigen::PartialPivLU<MatX> coarse_lu_;  ///< of E = Zᵀ W
   bool block_preconditioner_ = false;
   int iterations_after_refresh_ = -1;
+  bool have_preconditioner_ = false;
+  double preconditioner_h_ = -1.0;
+  int preconditioner_age_ = 0;     ///< steps (Prepare calls) since the preconditioner was built
   bool wants_refresh_ = false;
   long krylov_total_ = 0;
   // The explicit coupling's solve with a matrix-free 𝕄: block LU of the self-mobilities.

@@ -159,6 +159,7 @@ NewtonReport SolveNewton(const Model& model, const State& start, double h, Works
                ws->factors_age >= model.newton.jacobian_max_age || ws->last_iterations > 3 ||
                (saddle && ws->hydro.wants_refresh());
   Evaluate(model, start, h, ws->q, ws->hydro_force, fresh, ws, &ws->frames, &ws->residual);
+  if (fresh) ws->factors_valid = false;  // ws->jacobian now holds an unfactorized assembly
   if (saddle)
     ws->hydro.VelocityResidual(model, ws->q, start.q, h, ws->hydro_force, &ws->velocity_residual);
   auto norm_of = [&](const VecX& r, const VecX& r_u) {
@@ -260,20 +261,50 @@ void PrepareStep(const Model& model, const State& start, Workspace* ws) {
 
 StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
   StepReport report;
-  PrepareStep(model, *state, ws);
-
   // Algorithm 1's guess q_k + h q̇_k, plus ½h² q̈_k once two velocities are known: rods that
   // turn by a sizeable angle per step move on circles, which the linear guess misses. Contact
   // rounds after the first start from the previous round's solution.
   ws->q = state->q + h * state->velocity;
-  if (ws->previous_velocity.size() == state->velocity.size())
-    ws->q += 0.5 * h * (state->velocity - ws->previous_velocity);
+  const bool have_previous = ws->previous_velocity.size() == state->velocity.size();
+  if (have_previous) ws->q += 0.5 * h * (state->velocity - ws->previous_velocity);
   for (const RodModel& rod : model.rods)
     for (int k : rod.fixed_dofs) ws->q(rod.dof_offset + k) = state->q(rod.dof_offset + k);
   DriveBoundaryConditions(model, h, &ws->q);
 
+  // Every step is solved in implicit Euler's form, v(q) = (q − q̃)/h_e and M (v(q) − ṽ)/h_e =
+  // F(q, v(q)): implicit Euler has q̃ = q_k, ṽ = q̇_k, h_e = h; BDF2 (from the second step at an
+  // unchanged h) has q̃ = (4q_k − q_{k−1})/3, ṽ = (4q̇_k − q̇_{k−1})/3, h_e = 2h/3, and takes the
+  // mobility and the local drag at the predictor (second order) instead of at q_k.
+  const bool bdf2 = model.integrator == TimeIntegrator::kBdf2 && have_previous &&
+                    ws->previous_q.size() == state->q.size() && ws->previous_h == h;
+  const double he = bdf2 ? 2.0 * h / 3.0 : h;
+  State& start = ws->step_start;
+  start.time = state->time;
+  start.step = state->step;
+  if (bdf2) {
+    start.q = (4.0 * state->q - ws->previous_q) / 3.0;
+    start.velocity = (4.0 * state->velocity - ws->previous_velocity) / 3.0;
+  } else {
+    start.q = state->q;
+    start.velocity = state->velocity;
+  }
+  std::swap(start.rods, state->rods);  // the frames at q_k, lent for the step
+  struct GiveBack {
+    State* from;
+    State* to;
+    ~GiveBack() { std::swap(from->rods, to->rods); }
+  } give_back{&start, state};
+  if (bdf2) {
+    State geometry;  // where the step's mobility and local drag are taken
+    geometry.q = ws->q;
+    geometry.velocity = state->velocity;
+    PrepareStep(model, geometry, ws);
+  } else {
+    PrepareStep(model, start, ws);
+  }
+
   for (report.contact_rounds = 1;; ++report.contact_rounds) {
-    const NewtonReport newton = SolveNewton(model, *state, h, ws);
+    const NewtonReport newton = SolveNewton(model, start, he, ws);
     report.newton_iterations += newton.iterations;
     report.krylov_iterations += newton.krylov_iterations;
     if (!newton.converged) {
@@ -284,18 +315,18 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
       return report;
     }
     if (!model.contact) break;
-    if (!ws->factors_valid || ws->factors_h != h) {  // the response needs the Newton matrix
-      Evaluate(model, *state, h, ws->q, ws->hydro_force, true, ws, &ws->frames, &ws->residual);
-      ws->factors_valid = FactorizeJacobian(model, h, ws);
-      ws->factors_h = h;
+    if (!ws->factors_valid || ws->factors_h != he) {  // the response needs the Newton matrix
+      Evaluate(model, start, he, ws->q, ws->hydro_force, true, ws, &ws->frames, &ws->residual);
+      ws->factors_valid = FactorizeJacobian(model, he, ws);
+      ws->factors_h = he;
       ws->factors_age = 0;
     }
     const VecX no_slip = VecX::Zero(ws->nonlocal_fluid ? 3 * model.num_nodes : 0);
     const LinearResponse respond = [&](const VecX& force, VecX* dq) {
       VecX df, du;  // −J⁻¹(−F) = J⁻¹ F, the drag responding with the rods
-      report.krylov_iterations += NewtonCorrection(model, h, -force, no_slip, ws, dq, &df, &du);
+      report.krylov_iterations += NewtonCorrection(model, he, -force, no_slip, ws, dq, &df, &du);
     };
-    report.contact = AddContactForces(model, ws->q, h, respond, &ws->contact_force);
+    report.contact = AddContactForces(model, ws->q, he, respond, &ws->contact_force);
     if (report.contact.active == 0) break;  // report.contact describes the final state
     report.contact_pairs = std::max(report.contact_pairs, report.contact.detected);
     if (report.contact_rounds >= model.newton.max_contact_rounds) {
@@ -308,9 +339,12 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
     }
   }
   ws->previous_velocity = state->velocity;
-  state->velocity = (ws->q - state->q) / h;
+  ws->previous_q = state->q;
+  ws->previous_h = h;
+  state->velocity = (ws->q - start.q) / he;
   state->q = ws->q;
-  std::swap(state->rods, ws->frames);  // ws->frames is rewritten by the next Evaluate
+  std::swap(start.rods, ws->frames);  // the new frames go to the state by give_back;
+                                      // ws->frames is rewritten by the next Evaluate
   state->time += h;
   ++state->step;
   ++ws->factors_age;

@@ -58,7 +58,10 @@ struct Workspace {
   VecX force;                    ///< F_int + F_ext + F^h + F^c at q (after a converged solve)
   VecX residual, residual_try, delta, simplified;
   VecX contact_force;            ///< F^c, constant during a Newton solve
-  VecX previous_velocity;        ///< q̇(t_{k−1}), for the second-order predictor
+  VecX previous_velocity;        ///< q̇(t_{k−1}), for the second-order predictor and BDF2
+  VecX previous_q;               ///< q(t_{k−1}), for BDF2
+  double previous_h = 0.0;       ///< the step that led to t_k
+  State step_start;              ///< the start of the step in implicit Euler's form (see Step)
   std::vector<BandedMatrix> jacobian;  ///< per rod
   double load_factor = 1.0;      ///< static load continuation
   // Reuse of the factorized Newton matrix across iterations and steps (modified Newton).
@@ -85,7 +88,8 @@ void Evaluate(const Model& model, const State& start, double h, const VecX& q,
 /// (θ0 ← θ0 + h ω' for driven rods, everything else held).
 void DriveBoundaryConditions(const Model& model, double h, VecX* q);
 
-/// One implicit Euler step of size h from `state` (Algorithm 1 with the contact rounds).
+/// One step of size h from `state` (Algorithm 1 with the contact rounds): implicit Euler, or
+/// BDF2 when model.integrator says so and the previous step (same h) is known.
 StepReport Step(const Model& model, double h, State* state, Workspace* ws);
 
 /// Static equilibrium F_int + F_ext = 0 under the loads and boundary conditions, by Newton with

@@ -61,6 +61,9 @@ struct RodModel {
 };
 
 enum class FluidCoupling { kImplicit, kExplicit };
+/// kEuler: implicit Euler (paper eq. 22), first order. kBdf2: the two-step backward
+/// differentiation formula, second order (its first step is implicit Euler).
+enum class TimeIntegrator { kEuler, kBdf2 };
 
 struct NewtonOptions {
   double tolerance = 1e-8;     ///< on the residual force, relative to the force scale [–]
@@ -84,6 +87,7 @@ struct Model {
   std::vector<RodModel> rods;
   FluidParams fluid;                 ///< fluid.model == kNone: no hydrodynamics
   FluidCoupling coupling = FluidCoupling::kImplicit;
+  TimeIntegrator integrator = TimeIntegrator::kEuler;
   HydroOptions hydro;
   bool contact = false;
   Vec3 gravity = Vec3::Zero();       ///< [m/s²]
