@@ -131,7 +131,10 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
         const int first = 3 * model.rods[r].node_offset, n = static_cast<int>(sx_blocks_[r].rows());
         capacitance.block(first, first, n, n) += sx_blocks_[r];
       }
-      capacitance_lu_.compute(capacitance);
+      if (krylov_)
+        capacitance_lu_float_.compute(capacitance.cast<float>());
+      else
+        capacitance_lu_.compute(capacitance);
     }
   }
   mobility_changed_ = false;
@@ -245,7 +248,7 @@ void HydroCoupling::BuildCoarseLevel(const Model& model, double h,
 
 void HydroCoupling::Precondition(const VecX& v, VecX* out) const {
   if (!block_preconditioner_) {
-    *out = capacitance_lu_.solve(v);
+    *out = capacitance_lu_float_.solve(v.cast<float>()).cast<double>();
     return;
   }
   // Coarse: c = E⁻¹ Zᵀ v; then the blocks on what the coarse correction leaves, y = Zc + D⁻¹(v − Wc).

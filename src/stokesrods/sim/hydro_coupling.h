@@ -97,8 +97,10 @@ class HydroCoupling {
   bool mobility_changed_ = true;   ///< 𝕄 was updated since the capacitance was factorized
   VecX explicit_force_;            ///< 3M
   std::vector<MatX> sx_blocks_;    ///< S_k B_k⁻¹ S_kᵀ (3N_k × 3N_k), for the preconditioner only
-  // Direct: the LU of C; krylov: the preconditioner (the LU of C, or of its diagonal blocks).
+  // Direct: the LU of C; krylov: the preconditioner (the LU of C in single precision — a
+  // preconditioner needs no more, and its solves stream half the memory —, or two levels).
   Eigen::PartialPivLU<MatX> capacitance_lu_;
+  Eigen::PartialPivLU<Eigen::MatrixXf> capacitance_lu_float_;
   std::vector<Eigen::PartialPivLU<MatX>> block_lu_;
   void BuildCoarseLevel(const Model& model, double h, const std::vector<MatX>& blocks);
   std::vector<int> chunk_first_;   ///< first global node of each chunk; back() = M

@@ -2,8 +2,9 @@
 // Sparse Linear Systems, 2nd ed., Algorithm 9.5), for operators given only by their products.
 //
 // Solves A x = b by minimizing |b − A P⁻¹ y| over a Krylov space of A P⁻¹, x = P⁻¹ y. With right
-// preconditioning the residual it monitors is the true residual of A x = b (not a preconditioned
-// one), so the stopping test |b − A x| ≤ tolerance |b| means what it says. Arnoldi by modified
+// preconditioning the residual it monitors is the residual of A x = b (not a preconditioned
+// one), so the stopping test |b − A x| ≤ tolerance |b| means what it says; A x is carried by the
+// Arnoldi relation A Z_k = V_{k+1} H̄_k, so a solve of k iterations costs k products. Arnoldi by modified
 // Gram–Schmidt, the least-squares problem by Givens rotations.
 #pragma once
 
@@ -26,12 +27,12 @@ struct GmresOptions {
 struct GmresReport {
   bool converged = false;
   int iterations = 0;        ///< products with A
-  double relative_residual = 0.0;  ///< |b − A x| / |b| at the end (recomputed, not estimated)
+  double relative_residual = 0.0;  ///< |b − A x| / |b| at the end (A x from the Arnoldi relation)
 };
 
 /// Solves A x = b; x holds the initial guess on entry (resized to zero if empty) and the
-/// solution on exit; `ax`, if given, receives A x of the returned x (computed, one product that
-/// the final residual needs anyway). `preconditioner` may be empty (identity).
+/// solution on exit; `ax`, if given, receives A x of the returned x (from the Arnoldi relation;
+/// exact up to rounding). `preconditioner` may be empty (identity).
 GmresReport SolveGmres(const LinearOperator& a, const LinearOperator& preconditioner,
                        const VecX& b, const GmresOptions& options, VecX* x, VecX* ax = nullptr);
 
