@@ -63,7 +63,7 @@ struct GravityConfig {
 struct SolverConfig {
   double newton_tolerance = 1e-8;   ///< residual force / force scale
   int newton_max_iterations = 30;
-  int jacobian_max_age = 20;        ///< steps a factorized Newton matrix may be reused
+  int jacobian_max_age = 1;         ///< steps a factorized banded Newton matrix may be reused
   double damping = 0.0;             ///< isotropic viscous damping per unit length [Pa·s]
 };
 

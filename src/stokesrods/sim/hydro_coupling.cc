@@ -31,6 +31,8 @@ std::vector<HydroRod> MakeHydroRods(const Model& model, const std::vector<Matrix
 }
 
 constexpr int kFullLuBelow = 3000;
+// Steps a Krylov preconditioner is kept at most (it is rebuilt sooner when GMRES slows down).
+constexpr int kPreconditionerMaxAge = 20;
 
 void HydroCoupling::Init(const Model& model) {
   mobility_ = MakeMobilityOperator(model.fluid, model.hydro.mobility);
@@ -107,10 +109,10 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
     if (!b.Factorize()) return false;
   jacobian_ = jacobian;
   // The Krylov preconditioner (O((3M)³) for the full LU) is kept while it serves: rebuilt when
-  // GMRES slowed, h changed, or it is jacobian_max_age steps old; X and S X are always new.
+  // GMRES slowed, h changed, or it is kPreconditionerMaxAge steps old. B is always the new one.
   const bool rebuild = !krylov_ || !have_preconditioner_ || wants_refresh_ ||
                        preconditioner_h_ != h ||
-                       preconditioner_age_ >= std::max(1, model.newton.jacobian_max_age);
+                       preconditioner_age_ >= kPreconditionerMaxAge;
   if (rebuild) {
     have_preconditioner_ = true;
     preconditioner_h_ = h;

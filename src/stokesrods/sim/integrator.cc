@@ -73,9 +73,13 @@ void Evaluate(const Model& model, const State& start, double h, const VecX& q,
   TransportFrames(model, q, start.rods, frames);
   ws->force.setZero();
   std::vector<BandedMatrix>* jac = with_jacobian ? &ws->jacobian : nullptr;
-  for (std::size_t r = 0; r < model.rods.size(); ++r) {
-    if (jac) (*jac)[r].SetZero();
-    AddElasticForces(model.rods[r], q, (*frames)[r], &ws->force, jac ? &(*jac)[r] : nullptr);
+  // Rods in parallel: each writes only its own DOFs of the force and its own banded matrix.
+  const int num_rods = static_cast<int>(model.rods.size());
+#pragma omp parallel for schedule(dynamic) if (num_rods > 1)
+  for (int r = 0; r < num_rods; ++r) {
+    if (jac) (*jac)[static_cast<size_t>(r)].SetZero();
+    AddElasticForces(model.rods[static_cast<size_t>(r)], q, (*frames)[static_cast<size_t>(r)],
+                     &ws->force, jac ? &(*jac)[static_cast<size_t>(r)] : nullptr);
   }
   const StepContext ctx{&start.q, h, ws->load_factor};
   for (const auto& f : ws->local_forces) f->AddTo(model, ctx, q, &ws->force, jac);

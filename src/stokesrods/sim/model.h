@@ -71,7 +71,7 @@ struct NewtonOptions {
   int max_contact_rounds = 50; ///< Algorithm 1: solve–detect–re-solve rounds per step
   double contact_tolerance = 1e-3;  ///< a pair is resolved when distance ≥ 2r0 (1 − this)
   /// Steps a factorized Newton matrix may be reused for (0: rebuild at every iteration).
-  int jacobian_max_age = 20;
+  int jacobian_max_age = 1;
 };
 
 /// How the capacitance C = h𝕄 + S X of the implicit coupling is solved (sim/hydro_coupling.h).

@@ -28,7 +28,10 @@ State MakeRestState(const Model& model) {
 void TransportFrames(const Model& model, const VecX& q, const std::vector<RodFrames>& from,
                      std::vector<RodFrames>* to) {
   to->resize(from.size());
-  for (std::size_t r = 0; r < from.size(); ++r) {
+  const int num_rods = static_cast<int>(from.size());
+#pragma omp parallel for schedule(dynamic) if (num_rods > 1)
+  for (int ri = 0; ri < num_rods; ++ri) {
+    const auto r = static_cast<std::size_t>(ri);
     RodFrames& out = (*to)[r];
     out.frames = from[r].frames;
     out.tangents = from[r].tangents;
