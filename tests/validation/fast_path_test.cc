@@ -1,8 +1,8 @@
 // The fast hydrodynamic paths against the reference they replace, on whole time series:
 //   reference : dense 𝕄, the capacitance C = h𝕄 + S X by a fresh dense LU at every step;
-//   krylov    : dense 𝕄, C by GMRES preconditioned with a kept LU (the default up to 1000 nodes);
+//   krylov    : dense 𝕄, C by GMRES preconditioned with a kept LU (the default up to 500 nodes);
 //   matrix_free: 𝕄 never formed (exact near pairs, Gauss far field, Stokeslet sum), GMRES with
-//               per-rod block preconditioning (the default above 1000 nodes).
+//               per-rod block preconditioning (the default above 500 nodes).
 // All solve the same discrete equations; the fast ones stop GMRES at the Newton tolerance, and
 // matrix-free also carries the far-field tolerance (1e-8). Expected difference: the Newton
 // tolerance (1e-8 of the force scale) times the system's compliance, ~1e-9 of the rod length over

@@ -174,14 +174,14 @@ Model BuildModel(const Config& config) {
     model.rods.push_back(std::move(rod));
   }
   FinalizeLayout(&model);
-  // "auto": the dense 𝕄 (3M × 3M) while it is small; above 1000 nodes (a 72 MB matrix, and a
-  // capacitance LU of 3000²) the matrix-free operator. Measured crossover (docs/performance.md):
-  // 10 helices (650 nodes) 111 ms dense against 124 ms matrix-free per step; 20 helices (1300)
-  // 441 against 464 ms, with 8× less memory matrix-free.
+  // "auto": the dense 𝕄 (3M × 3M) while it is small, the matrix-free operator above 500 nodes.
+  // Measured (docs/performance.md, one thread, h = 1 ms): 2 helices (130 nodes) 2.1 ms dense
+  // against 3.6 ms matrix-free, 4 helices (260) 7.2 against 10.7 ms, 10 helices (650) 58.9
+  // against 52.6 ms with 3× less memory.
   const bool matrix_free =
       config.fluid.mobility == "matrix_free" ||
       (config.fluid.mobility == "auto" && model.fluid.model == FluidModel::kRss &&
-       model.num_nodes > 1000 && config.fluid.solver != "direct");
+       model.num_nodes > 500 && config.fluid.solver != "direct");
   model.hydro.mobility.kind = matrix_free ? MobilityKind::kMatrixFree : MobilityKind::kDense;
   // The dense 𝕄 of the Krylov path is assembled to the far-field tolerance (fewer Gauss points
   // far away); the direct solver, the reference, keeps round-off.

@@ -43,7 +43,7 @@ struct FluidConfig {
   double viscosity = 1.0;          ///< μ [Pa·s]
   double regularization = 1.02;    ///< ε / r0
   std::string coupling = "implicit";  ///< "implicit" | "explicit"
-  /// "auto" (dense up to 1000 nodes, else matrix-free) | "dense" | "matrix_free" (RSS only)
+  /// "auto" (dense up to 500 nodes, else matrix-free) | "dense" | "matrix_free" (RSS only)
   std::string mobility = "auto";
   double far_field_tolerance = 1e-8;  ///< matrix-free: relative error of the far field [–]
   std::string solver = "krylov";      ///< implicit coupling: "krylov" (GMRES) | "direct" (dense LU)
