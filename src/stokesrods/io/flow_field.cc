@@ -6,7 +6,9 @@
 #include <fmt/format.h>
 
 #include "stokesrods/io/writers.h"
+#include "stokesrods/fluid/mobility_operator.h"
 #include "stokesrods/sim/hydro_coupling.h"
+#include "stokesrods/solver/gmres.h"
 
 namespace stokesrods {
 
@@ -18,11 +20,35 @@ std::string WriteFlowField(const Model& model, const State& state, const FlowFie
   for (int r = 0; r < static_cast<int>(model.rods.size()); ++r)
     positions.push_back(RodPositions(model, r, state.q));
   const std::vector<HydroRod> rods = MakeHydroRods(model, positions);
-  MatX mobility;
-  AssembleMobility(model.fluid, rods, &mobility);
   VecX u;
   GatherNodeVelocities(model, state.velocity, VecX::Zero(state.velocity.size()), 1.0, &u);
-  const VecX forces = mobility.partialPivLu().solve(u);  // on the fluid
+  // The nodal forces on the fluid at the current positions and velocities, 𝕄 F = U: a dense LU
+  // while 𝕄 is dense; with the matrix-free operator GMRES, preconditioned by the rods' own
+  // self-mobilities (a dense 𝕄 of a hundred flagella would take 3 GB).
+  VecX forces;
+  const std::unique_ptr<MobilityOperator> mobility =
+      MakeMobilityOperator(model.fluid, model.hydro.mobility);
+  mobility->Update(rods);
+  if (const MatX* m = mobility->matrix()) {
+    forces = m->partialPivLu().solve(u);
+  } else {
+    std::vector<Eigen::PartialPivLU<MatX>> blocks;
+    for (int r = 0; r < mobility->num_rods(); ++r) blocks.emplace_back(mobility->SelfBlock(r));
+    const LinearOperator apply = [&](const VecX& x, VecX* y) { mobility->Apply(x, y); };
+    const LinearOperator precondition = [&](const VecX& x, VecX* y) {
+      y->resize(x.size());
+      for (int r = 0; r < mobility->num_rods(); ++r) {
+        const int first = 3 * mobility->node_offset(r);
+        const int n = 3 * (mobility->node_offset(r + 1) - mobility->node_offset(r));
+        y->segment(first, n) = blocks[static_cast<size_t>(r)].solve(x.segment(first, n));
+      }
+    };
+    const GmresReport g = SolveGmres(apply, precondition, u, {.tolerance = 1e-10}, &forces);
+    if (!g.converged)
+      throw IoError(fmt::format("{}: flow field not written: the mobility solve reached only {:.1e} "
+                                "after {} iterations", output_dir, g.relative_residual,
+                                g.iterations));
+  }
 
   const int nu = plane.resolution[0], nv = plane.resolution[1];
   std::string vts = fmt::format(
