@@ -29,13 +29,12 @@ struct Series {
   double krylov_per_step = 0.0;
 };
 
-Series RunSeries(const std::string& toml, int steps, int every) {
+Series RunSeries(const std::string& toml, int steps, int every, double h = 0.01) {
   const Model model = ModelFromToml(toml);
   State state = MakeRestState(model);
   Workspace ws(model);
   Series s;
   long krylov = 0;
-  const double h = 0.01;
   for (int k = 1; k <= steps; ++k) {
     const StepReport r = Step(model, h, &state, &ws);
     EXPECT_TRUE(r.ok) << r.message;
@@ -97,6 +96,63 @@ TEST(FastPath, Fig1TwoFlagella) {
           "Fig. 1, dense + GMRES");
   Compare(ref, RunSeries(Fig1("mobility = \"matrix_free\"", 65), 60, 10), 0.01,
           "Fig. 1, matrix-free + GMRES");
+}
+
+// The explicit coupling (paper Algorithm 1) solves 𝕄 f = −U once per step: dense LU against
+// GMRES with the matrix-free operator, at its stable step. And LSBT (dense only) through GMRES
+// against its direct solve.
+TEST(FastPath, ExplicitCouplingAndLsbt) {
+  auto two_helices = [](const std::string& fluid, int nodes) {
+    return R"(
+[run]
+duration = 1.0
+time_step = 2e-4
+[fluid]
+)" + fluid + R"(
+[contact]
+enabled = true
+[[rods]]
+nodes = )" + std::to_string(nodes) + R"(
+axis_length = 0.1
+helix_radius = 0.008
+omega_bar = 300
+[[rods]]
+nodes = )" + std::to_string(nodes) + R"(
+axis_length = 0.1
+helix_radius = 0.008
+base = [0.0175, 0.0, 0.0]
+omega_bar = 300
+)";
+  };
+  const std::string explicit_rss = "model = \"rss\"\ncoupling = \"explicit\"\n";
+  const Series ref = RunSeries(two_helices(explicit_rss + "mobility = \"dense\"", 15), 40, 10, 2e-4);
+  Compare(ref, RunSeries(two_helices(explicit_rss + "mobility = \"matrix_free\"", 15), 40, 10, 2e-4),
+          0.008, "explicit coupling, matrix-free + GMRES");
+  // LSBT needs edges of length r0√e: the paper's helix with N = 195 (appendix C).
+  const std::string lsbt = R"(
+[run]
+duration = 1.0
+[fluid]
+model = "lsbt"
+SOLVER
+[contact]
+enabled = true
+[[rods]]
+nodes = 195
+omega_bar = 320
+[[rods]]
+nodes = 195
+omega_bar = 320
+base = [0.03, 0.0, 0.0]
+)";
+  auto with = [&](const std::string& solver) {
+    std::string t = lsbt;
+    t.replace(t.find("SOLVER"), 6, solver);
+    return t;
+  };
+  const Series lsbt_ref = RunSeries(with("solver = \"direct\""), 20, 5, 1e-3);
+  Compare(lsbt_ref, RunSeries(with("solver = \"krylov\""), 20, 5, 1e-3), 0.01,
+          "LSBT, dense + GMRES");
 }
 
 TEST(FastPath, TenFlagellaOnARing) {
