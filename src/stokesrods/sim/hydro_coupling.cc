@@ -310,6 +310,8 @@ HydroSolveReport HydroCoupling::SolveNewtonSystem(const Model& model,
     report.krylov_iterations = g.iterations;
     report.relative_residual = g.relative_residual;
     krylov_total_ += g.iterations;
+    if (!g.converged && (worst_solve_.ok || g.relative_residual > worst_solve_.relative_residual))
+      worst_solve_ = report;
     if (iterations_after_refresh_ < 0) iterations_after_refresh_ = g.iterations;
     wants_refresh_ = g.iterations > 2 * iterations_after_refresh_ + 2;
   }

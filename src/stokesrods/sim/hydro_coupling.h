@@ -80,6 +80,9 @@ class HydroCoupling {
   bool wants_refresh() const { return wants_refresh_ || (!krylov_ && mobility_changed_); }
 
   const MobilityOperator& mobility() const { return *mobility_; }
+  /// The worst Krylov solve since the last call to ResetSolveReport (for failure messages).
+  const HydroSolveReport& worst_solve() const { return worst_solve_; }
+  void ResetSolveReport() { worst_solve_ = HydroSolveReport{}; }
   long krylov_iterations() const { return krylov_total_; }  ///< over the whole run
 
  private:
@@ -113,6 +116,7 @@ class HydroCoupling {
   int preconditioner_age_ = 0;     ///< steps (Prepare calls) since the preconditioner was built
   bool wants_refresh_ = false;
   long krylov_total_ = 0;
+  HydroSolveReport worst_solve_;
   // The explicit coupling's solve with a matrix-free 𝕄: block LU of the self-mobilities.
   std::vector<Eigen::PartialPivLU<MatX>> mobility_block_lu_;
   int mobility_blocks_age_ = 0;

@@ -307,6 +307,7 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
     PrepareStep(model, start, ws);
   }
 
+  if (ws->nonlocal_fluid) ws->hydro.ResetSolveReport();
   for (report.contact_rounds = 1;; ++report.contact_rounds) {
     const NewtonReport newton = SolveNewton(model, start, he, ws);
     report.newton_iterations += newton.iterations;
@@ -316,6 +317,11 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
           "Newton did not converge at t = {:.6g} s: residual {:.3e} N > tolerance {:.3e} N after "
           "{} iterations",
           state->time + h, newton.residual, newton.tolerance, newton.iterations);
+      if (ws->nonlocal_fluid && !ws->hydro.worst_solve().ok)
+        report.message += fmt::format(
+            "; a GMRES solve of the drag stopped at a relative residual of {:.1e} after {} "
+            "products (try fluid.solver = \"direct\" or a smaller time step)",
+            ws->hydro.worst_solve().relative_residual, ws->hydro.worst_solve().krylov_iterations);
       return report;
     }
     if (!model.contact) break;

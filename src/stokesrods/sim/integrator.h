@@ -1,10 +1,12 @@
 // The time step (paper section 2.4, Algorithm 1) and the static solve.
 //
-// One step of implicit Euler (eq. 22) solved by Newton's method (Jacobian eq. 23 plus the
+// One step of implicit Euler (eq. 22) or BDF2 solved by Newton's method (Jacobian eq. 23 plus the
 // Jacobians of the implicit external forces):
-//     r(q) = M (q − q_k − h v_k) / h² − F_int(q) − F_ext(q) − F^h(q) − F^c = 0,
-// q_{k+1} = q, v_{k+1} = (q_{k+1} − q_k)/h. Step never prints, writes files or exits: failures
-// come back as a report, and the state is left as it was before the step.
+//     r(q) = M (q − q_k − h v_k) / h² − F_int(q) − F_ext(q) − F^h − F^c = 0,
+// q_{k+1} = q, v_{k+1} = (q_{k+1} − q_k)/h; with a nonlocal fluid and the implicit coupling the
+// drag F^h = f is an unknown beside q with its no-slip equation (sim/hydro_coupling.h). Step never
+// prints, writes files or exits: failures come back as a report, and the state is left as it was
+// before the step.
 #pragma once
 
 #include <memory>
@@ -65,7 +67,7 @@ struct Workspace {
   std::vector<BandedMatrix> jacobian;  ///< per rod
   double load_factor = 1.0;      ///< static load continuation
   // Reuse of the factorized Newton matrix across iterations and steps (modified Newton).
-  bool factors_valid = false;    ///< ws.jacobian (and the Woodbury factors) hold usable factors
+  bool factors_valid = false;    ///< ws.jacobian (and the capacitance's data) hold usable factors
   double factors_h = -1.0;       ///< the step size they were built for (0: static)
   int factors_age = 0;           ///< steps since they were built
   int last_iterations = 0;       ///< Newton iterations of the last converged solve
