@@ -47,7 +47,7 @@ struct FluidConfig {
   std::string mobility = "auto";
   double far_field_tolerance = 1e-8;  ///< matrix-free: relative error of the far field [–]
   std::string solver = "krylov";      ///< implicit coupling: "krylov" (GMRES) | "direct" (dense LU)
-  double krylov_tolerance = 1e-10;    ///< GMRES relative residual [–]
+  double krylov_tolerance = 1e-6;     ///< GMRES relative residual [–]
 };
 
 struct ContactConfig {

@@ -80,7 +80,7 @@ enum class HydroSolver { kDirect, kKrylov };
 struct HydroOptions {
   MobilityOptions mobility;                    ///< dense or matrix-free 𝕄
   HydroSolver solver = HydroSolver::kKrylov;
-  double krylov_tolerance = 1e-10;             ///< GMRES: |b − C x| ≤ this × |b|  [–]
+  double krylov_tolerance = 1e-6;              ///< GMRES: |b − C x| ≤ this × |b|  [–]
 };
 
 struct Model {
