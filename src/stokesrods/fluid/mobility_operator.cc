@@ -250,6 +250,19 @@ NearFarSplit ChooseNearFarSplit(double tolerance) {
   return split;
 }
 
+SelfMobilityPreconditioner::SelfMobilityPreconditioner(const MobilityOperator& mobility) {
+  for (int r = 0; r <= mobility.num_rods(); ++r) first_.push_back(3 * mobility.node_offset(r));
+  for (int r = 0; r < mobility.num_rods(); ++r) blocks_.emplace_back(mobility.SelfBlock(r));
+}
+
+void SelfMobilityPreconditioner::Apply(const VecX& in, VecX* out) const {
+  out->resize(in.size());
+  for (std::size_t r = 0; r < blocks_.size(); ++r) {
+    const int n = first_[r + 1] - first_[r];
+    out->segment(first_[r], n) = blocks_[r].solve(in.segment(first_[r], n));
+  }
+}
+
 std::unique_ptr<MobilityOperator> MakeMobilityOperator(const FluidParams& params,
                                                        const MobilityOptions& options) {
   if (options.kind == MobilityKind::kMatrixFree && params.model == FluidModel::kRss)

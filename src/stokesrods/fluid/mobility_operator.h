@@ -19,6 +19,8 @@
 #include <memory>
 #include <vector>
 
+#include <Eigen/LU>
+
 #include "stokesrods/fluid/hydrodynamics.h"
 #include "stokesrods/fluid/stokeslet_sum.h"
 
@@ -55,6 +57,20 @@ class MobilityOperator {
  protected:
   void SetLayout(const std::vector<HydroRod>& rods);
   std::vector<int> node_offset_ = {0};
+};
+
+/// Block-Jacobi approximation of 𝕄⁻¹ by the LU of each rod's self-mobility 𝕄_kk: the
+/// preconditioner of the solves 𝕄 F = U (explicit drag, flow field) with a matrix-free 𝕄.
+class SelfMobilityPreconditioner {
+ public:
+  /// Factorizes the self blocks of the operator at its current geometry.
+  explicit SelfMobilityPreconditioner(const MobilityOperator& mobility);
+  /// out ≈ 𝕄⁻¹ in, rod by rod.
+  void Apply(const VecX& in, VecX* out) const;
+
+ private:
+  std::vector<int> first_;  ///< first entry (3 × node) of each rod; back() = 3M
+  std::vector<Eigen::PartialPivLU<MatX>> blocks_;
 };
 
 /// The operator for the fluid model and options (matrix-free needs RSS; others fall back to dense).

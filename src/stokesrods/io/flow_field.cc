@@ -32,17 +32,9 @@ std::string WriteFlowField(const Model& model, const State& state, const FlowFie
   if (const MatX* m = mobility->matrix()) {
     forces = m->partialPivLu().solve(u);
   } else {
-    std::vector<Eigen::PartialPivLU<MatX>> blocks;
-    for (int r = 0; r < mobility->num_rods(); ++r) blocks.emplace_back(mobility->SelfBlock(r));
+    const SelfMobilityPreconditioner blocks(*mobility);
     const LinearOperator apply = [&](const VecX& x, VecX* y) { mobility->Apply(x, y); };
-    const LinearOperator precondition = [&](const VecX& x, VecX* y) {
-      y->resize(x.size());
-      for (int r = 0; r < mobility->num_rods(); ++r) {
-        const int first = 3 * mobility->node_offset(r);
-        const int n = 3 * (mobility->node_offset(r + 1) - mobility->node_offset(r));
-        y->segment(first, n) = blocks[static_cast<size_t>(r)].solve(x.segment(first, n));
-      }
-    };
+    const LinearOperator precondition = [&](const VecX& x, VecX* y) { blocks.Apply(x, y); };
     const GmresReport g = SolveGmres(apply, precondition, u, {.tolerance = 1e-10}, &forces);
     if (!g.converged)
       throw IoError(fmt::format("{}: flow field not written: the mobility solve reached only {:.1e} "

@@ -63,20 +63,14 @@ HydroSolveReport HydroCoupling::Prepare(const Model& model, const VecX& q_start,
     explicit_force_ = -m->partialPivLu().solve(u);
     return report;
   }
-  if (mobility_block_lu_.empty() || ++mobility_blocks_age_ >= model.newton.jacobian_max_age) {
-    mobility_block_lu_.clear();
-    for (int r = 0; r < mobility_->num_rods(); ++r)
-      mobility_block_lu_.emplace_back(mobility_->SelfBlock(r));
-    mobility_blocks_age_ = 0;
+  // The self-mobility blocks change little from step to step: rebuilt every 20 steps.
+  if (!explicit_blocks_ || ++explicit_blocks_age_ >= kPreconditionerMaxAge) {
+    explicit_blocks_ = std::make_unique<SelfMobilityPreconditioner>(*mobility_);
+    explicit_blocks_age_ = 0;
   }
   const LinearOperator apply = [&](const VecX& x, VecX* y) { mobility_->Apply(x, y); };
   const LinearOperator precondition = [&](const VecX& x, VecX* y) {
-    y->resize(x.size());
-    for (int r = 0; r < mobility_->num_rods(); ++r) {
-      const int first = 3 * mobility_->node_offset(r);
-      const int n = 3 * (mobility_->node_offset(r + 1) - mobility_->node_offset(r));
-      y->segment(first, n) = mobility_block_lu_[static_cast<size_t>(r)].solve(x.segment(first, n));
-    }
+    explicit_blocks_->Apply(x, y);
   };
   if (explicit_force_.size() != u.size()) explicit_force_.setZero(u.size());
   VecX negative_u = -u;

@@ -118,8 +118,8 @@ class HydroCoupling {
   long krylov_total_ = 0;
   HydroSolveReport worst_solve_;
   // The explicit coupling's solve with a matrix-free 𝕄: block LU of the self-mobilities.
-  std::vector<Eigen::PartialPivLU<MatX>> mobility_block_lu_;
-  int mobility_blocks_age_ = 0;
+  std::unique_ptr<SelfMobilityPreconditioner> explicit_blocks_;
+  int explicit_blocks_age_ = 0;
   mutable VecX scratch_;
 };
 
