@@ -10,41 +10,18 @@
 #include <cmath>
 #include <random>
 
+#include "common/helix_lattice.h"
 #include "stokesrods/fluid/stokeslet_sum.h"
 
 namespace stokesrods {
 namespace {
 
-struct Lattice {
-  Matrix3X sources, targets;
-  VecX regularization;
-};
+using Lattice = testing::PointCloud;
 
 // N helices on rows × cols: 1 = 1×1, 10 = 2×5, 20 = 4×5, 50 = 5×10, 100 = 10×10.
 Lattice HelixLattice(int helices) {
   const int rows = helices == 1 ? 1 : helices == 10 ? 2 : helices == 20 ? 4 : helices == 50 ? 5 : 10;
-  const int cols = helices / rows;
-  const int nodes = 65;
-  const double radius = 0.01, pitch = 0.05, length = 0.2, spacing = 0.04;
-  Lattice c;
-  c.targets.resize(3, rows * cols * nodes);
-  c.sources.resize(3, rows * cols * 2 * (nodes - 1));
-  int nt = 0, ns = 0;
-  for (int i = 0; i < rows; ++i) {
-    for (int j = 0; j < cols; ++j) {
-      const Vec3 base(spacing * i, spacing * j, 0.0);
-      auto at = [&](double z) {
-        const double phi = 2.0 * kPi * z / pitch;
-        return Vec3(base + Vec3(radius * std::cos(phi), radius * std::sin(phi), -z));
-      };
-      for (int k = 0; k < nodes; ++k) c.targets.col(nt++) = at(length * k / (nodes - 1));
-      for (int k = 0; k + 1 < nodes; ++k)
-        for (double a : {0.5 - 0.5 / std::sqrt(3.0), 0.5 + 0.5 / std::sqrt(3.0)})
-          c.sources.col(ns++) = at(length * (k + a) / (nodes - 1));
-    }
-  }
-  c.regularization = VecX::Constant(ns, 1.02e-3);
-  return c;
+  return testing::HelixLattice(rows, helices / rows);
 }
 
 std::unique_ptr<StokesletSum> MakeSum(int digits) {

@@ -1,6 +1,7 @@
 // The fast sum of regularized Stokeslets against the direct sum: random clouds and the helix
 // lattice of bench/bench_stokeslet_sum.cc at several tolerances, and the edge cases (a target on
 // a source, mixed ε, tiny problems, collinear points, six decades of distance).
+#include "common/helix_lattice.h"
 #include "stokesrods/fluid/stokeslet_sum.h"
 
 #include <gtest/gtest.h>
@@ -14,10 +15,7 @@
 namespace stokesrods {
 namespace {
 
-struct Cloud {
-  Matrix3X sources, targets;
-  VecX regularization;
-};
+using Cloud = testing::PointCloud;
 
 Matrix3X RandomStrengths(int n, std::mt19937* rng) {
   std::normal_distribution<double> normal;
@@ -37,31 +35,7 @@ Cloud RandomCloud(int ns, int nt, double size, double eps, std::mt19937* rng) {
   return c;
 }
 
-// Helices of 65 nodes (radius 0.01 m, pitch 0.05 m, axis 0.2 m along −z) on a square lattice
-// 0.04 m apart; sources: 2 Gauss points per segment, ε = 1.02e-3 m; targets: the nodes.
-Cloud HelixLattice(int rows, int cols) {
-  const int nodes = 65;
-  const double radius = 0.01, pitch = 0.05, length = 0.2, spacing = 0.04;
-  Cloud c;
-  c.targets.resize(3, rows * cols * nodes);
-  c.sources.resize(3, rows * cols * 2 * (nodes - 1));
-  int nt = 0, ns = 0;
-  for (int i = 0; i < rows; ++i) {
-    for (int j = 0; j < cols; ++j) {
-      const Vec3 base(spacing * i, spacing * j, 0.0);
-      auto at = [&](double z) {
-        const double phi = 2.0 * kPi * z / pitch;
-        return Vec3(base + Vec3(radius * std::cos(phi), radius * std::sin(phi), -z));
-      };
-      for (int k = 0; k < nodes; ++k) c.targets.col(nt++) = at(length * k / (nodes - 1));
-      for (int k = 0; k + 1 < nodes; ++k)
-        for (double a : {0.5 - 0.5 / std::sqrt(3.0), 0.5 + 0.5 / std::sqrt(3.0)})
-          c.sources.col(ns++) = at(length * (k + a) / (nodes - 1));
-    }
-  }
-  c.regularization = VecX::Constant(ns, 1.02e-3);
-  return c;
-}
+using testing::HelixLattice;
 
 // max over targets of |w − w_ref| / Σ_s |S(x_t − y_s)|₂ |g_s|, the error measure of the header.
 double RelativeError(const Cloud& c, const Matrix3X& g, const Matrix3X& w, const Matrix3X& ref) {
