@@ -178,7 +178,9 @@ void MatrixFreeRssMobility::FindNearPairs(const Matrix3X& targets) {
             const double alpha = std::clamp((p - xa).dot(v) / v.squaredNorm(), 0.0, 1.0);
             const double d2 = (p - xa - alpha * v).squaredNorm() + seg.eps * seg.eps;
             if (d2 >= split_.near_delta * split_.near_delta * v.squaredNorm()) continue;
-            const SegmentMobility exact = StokesletSegment(xa, xb, seg.eps, p);  // round-off
+            // The near pair to the far-field tolerance (closed forms below δ = 1, else Gauss).
+            const SegmentMobility exact =
+                StokesletSegment(xa, xb, seg.eps, p, params_.far_field_tolerance);
             const SegmentMobility rule =
                 StokesletSegmentGauss(xa, xb, seg.eps, p, split_.gauss_points);
             add(seg.a, exact.a - rule.a);
