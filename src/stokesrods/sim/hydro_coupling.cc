@@ -167,8 +167,11 @@ void HydroCoupling::SolveBanded(const Model& model, const VecX& nodal, const Vec
       out->segment<3>(rod.dof_offset + NodeDof(i)) += nodal.segment<3>(3 * (rod.node_offset + i));
     for (int k : rod.fixed_dofs) (*out)(rod.dof_offset + k) = dofs ? (*dofs)(rod.dof_offset + k) : 0.0;
   }
-  for (std::size_t r = 0; r < model.rods.size(); ++r)
-    (*jacobian_)[r].Solve(out->data() + model.rods[r].dof_offset, 1);
+  const int num_rods = static_cast<int>(model.rods.size());
+#pragma omp parallel for schedule(static) if (num_rods > 1)
+  for (int r = 0; r < num_rods; ++r)  // each rod's own DOFs
+    (*jacobian_)[static_cast<size_t>(r)].Solve(
+        out->data() + model.rods[static_cast<size_t>(r)].dof_offset, 1);
 }
 
 void HydroCoupling::ApplyCapacitance(const Model& model, double h, const VecX& v,
@@ -277,7 +280,10 @@ HydroSolveReport HydroCoupling::SolveNewtonSystem(const Model& model,
   // y = −B⁻¹ r_q, and S y.
   *dq = -r_q;
   VecX sy(3 * model.num_nodes);
-  for (std::size_t r = 0; r < model.rods.size(); ++r) {
+  const int num_rods = static_cast<int>(model.rods.size());
+#pragma omp parallel for schedule(static) if (num_rods > 1)
+  for (int ri = 0; ri < num_rods; ++ri) {  // each rod's own DOFs and nodes
+    const auto r = static_cast<std::size_t>(ri);
     const RodModel& rod = model.rods[r];
     jacobian[r].Solve(dq->data() + rod.dof_offset, 1);
     for (int i = 0; i < rod.num_nodes(); ++i)
