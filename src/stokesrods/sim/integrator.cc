@@ -170,15 +170,18 @@ NewtonReport SolveNewton(const Model& model, const State& start, double h, Works
     return saddle ? std::max(ResidualNorm(model, r), VelocityResidualNorm(model, r_u))
                   : ResidualNorm(model, r);
   };
+  // The force scale: the characteristic bending force or the applied forces (ws->force of the
+  // last Evaluate), if larger; never below the round-off floor of the stretching forces at q.
+  auto tolerance_at = [&](const VecX& q) {
+    const double scale = std::max(model.force_scale, ResidualNorm(model, ws->force));
+    return std::max(model.newton.tolerance * scale, RoundOffFloor(model, q));
+  };
   bool have_jacobian = fresh;
   bool have_correction = false;  // ws->delta already holds the correction at ws->q
   double norm = norm_of(ws->residual, ws->velocity_residual);
   bool small_correction = false;
   for (report.iterations = 0;; ++report.iterations) {
-    // The force scale: the characteristic bending force or the applied forces, if larger; never
-    // below the round-off floor of the stretching forces.
-    const double scale = std::max(model.force_scale, ResidualNorm(model, ws->force));
-    report.tolerance = std::max(model.newton.tolerance * scale, RoundOffFloor(model, ws->q));
+    report.tolerance = tolerance_at(ws->q);
     report.residual = norm;
     if (norm <= report.tolerance || small_correction) {
       report.converged = true;
@@ -216,10 +219,7 @@ NewtonReport SolveNewton(const Model& model, const State& start, double h, Works
       // A full step that already meets the tolerance is accepted without its simplified
       // correction (one linear solve less at the end of each step).
       if (alpha == 1.0 &&
-          norm_of(ws->residual_try, ws->velocity_residual_try) <=
-              std::max(model.newton.tolerance *
-                           std::max(model.force_scale, ResidualNorm(model, ws->force)),
-                       RoundOffFloor(model, ws->q_try))) {
+          norm_of(ws->residual_try, ws->velocity_residual_try) <= tolerance_at(ws->q_try)) {
         simplified_norm = 0.0;
         ws->simplified.setZero();
         if (saddle) ws->simplified_hydro_delta.setZero(), ws->simplified_hydro_rate.setZero();
