@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/model_from_toml.h"
+#include "common/small_helices.h"
 #include "stokesrods/io/flow_field.h"
 #include "stokesrods/sim/integrator.h"
 
@@ -31,26 +32,8 @@ std::vector<double> ReadSpeeds(const std::string& csv) {
 }
 
 std::vector<double> FlowWith(const std::string& mobility, const std::string& dir) {
-  const Model model = testing::ModelFromToml(R"(
-[run]
-duration = 1.0
-[fluid]
-model = "rss"
-mobility = ")" + mobility + R"("
-[contact]
-enabled = false
-[[rods]]
-nodes = 21
-axis_length = 0.1
-helix_radius = 0.008
-omega_bar = 300
-[[rods]]
-nodes = 21
-axis_length = 0.1
-helix_radius = 0.008
-base = [0.0175, 0.0, 0.0]
-omega_bar = 300
-)");
+  const Model model = testing::ModelFromToml(testing::SmallHelicesToml(
+      2, 21, 300, "model = \"rss\"\nmobility = \"" + mobility + "\""));
   State state = MakeRestState(model);
   Workspace ws(model);
   for (int k = 0; k < 10; ++k) EXPECT_TRUE(Step(model, 0.01, &state, &ws).ok);

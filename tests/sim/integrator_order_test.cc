@@ -7,26 +7,15 @@
 #include <string>
 
 #include "common/model_from_toml.h"
+#include "common/small_helices.h"
 #include "stokesrods/sim/integrator.h"
 
 namespace stokesrods {
 namespace {
 
 Vec3 TipAt(const std::string& integrator, double h, double t_end) {
-  const Model model = testing::ModelFromToml(R"(
-[run]
-duration = 1.0
-integrator = ")" + integrator + R"("
-[fluid]
-model = "rss"
-[contact]
-enabled = false
-[[rods]]
-nodes = 15
-axis_length = 0.1
-helix_radius = 0.008
-omega_bar = 600
-)");
+  const Model model = testing::ModelFromToml(testing::SmallHelicesToml(
+      1, 15, 600, "model = \"rss\"", "integrator = \"" + integrator + "\""));
   State state = MakeRestState(model);
   Workspace ws(model);
   const int steps = static_cast<int>(std::lround(t_end / h));

@@ -8,6 +8,7 @@
 #include <Eigen/LU>
 
 #include "common/model_from_toml.h"
+#include "common/small_helices.h"
 #include "stokesrods/sim/hydro_coupling.h"
 #include "stokesrods/sim/integrator.h"
 #include "stokesrods/sim/state.h"
@@ -126,27 +127,8 @@ TEST(Jacobian, RotatingHelixInMotion) {
 // residual, that the saddle solve (δq, δf) gives δq = −J⁻¹ r (dense LU of J as the reference)
 // for each mobility and capacitance solver, and that du tracks r_u along (δq, δf).
 void CheckImplicitNonlocalDrag(const std::string& fluid_options, double solve_tolerance) {
-  Model model = ModelFromToml(R"(
-[run]
-duration = 1.0
-time_step = 0.01
-[fluid]
-model = "rss"
-)" + fluid_options + R"(
-[contact]
-enabled = false
-[[rods]]
-nodes = 15
-axis_length = 0.1
-helix_radius = 0.008
-omega_bar = 300
-[[rods]]
-nodes = 15
-axis_length = 0.1
-helix_radius = 0.008
-base = [0.0175, 0.0, 0.0]
-omega_bar = 300
-)");
+  Model model = ModelFromToml(testing::SmallHelicesToml(
+      2, 15, 300, "model = \"rss\"\n" + fluid_options, "time_step = 0.01"));
   const double h = 0.01;
   State state = MakeRestState(model);
   Workspace ws(model);

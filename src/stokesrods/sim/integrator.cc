@@ -299,7 +299,7 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
     ~GiveBack() { std::swap(from->rods, to->rods); }
   } give_back{&start, state};
   if (bdf2) {
-    State geometry;  // where the step's mobility and local drag are taken
+    State& geometry = ws->step_geometry;  // where the step's mobility and local drag are taken
     geometry.q = ws->q;
     geometry.velocity = state->velocity;
     PrepareStep(model, geometry, ws);

@@ -64,6 +64,7 @@ struct Workspace {
   VecX previous_q;               ///< q(t_{k−1}), for BDF2
   double previous_h = 0.0;       ///< the step that led to t_k
   State step_start;              ///< the start of the step in implicit Euler's form (see Step)
+  State step_geometry;           ///< BDF2: the predictor, where 𝕄 and the local drag are taken
   std::vector<BandedMatrix> jacobian;  ///< per rod
   double load_factor = 1.0;      ///< static load continuation
   // Reuse of the factorized Newton matrix across iterations and steps (modified Newton).
