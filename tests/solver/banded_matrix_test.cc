@@ -2,10 +2,80 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/LU>
+
 #include <random>
+#include <vector>
+
+extern "C" {
+void dgbtrf_(const int* m, const int* n, const int* kl, const int* ku, double* ab,
+             const int* ldab, int* ipiv, int* info);
+void dgbtrs_(const char* trans, const int* n, const int* kl, const int* ku, const int* nrhs,
+             const double* ab, const int* ldab, const int* ipiv, double* b, const int* ldb,
+             int* info, std::size_t trans_len);
+}
 
 namespace stokesrods {
 namespace {
+
+// LAPACK's banded LU of the same matrix: the reference our own factorization replaces.
+MatX SolveWithLapack(const MatX& dense, int kd, const MatX& b) {
+  const int n = static_cast<int>(dense.rows()), ldab = 3 * kd + 1, nrhs = static_cast<int>(b.cols());
+  std::vector<double> ab(static_cast<std::size_t>(ldab) * n, 0.0);
+  for (int j = 0; j < n; ++j)
+    for (int i = std::max(0, j - kd); i <= std::min(n - 1, j + kd); ++i)
+      ab[static_cast<std::size_t>(2 * kd + i - j + j * ldab)] = dense(i, j);
+  std::vector<int> pivots(static_cast<std::size_t>(n));
+  int info = 0;
+  dgbtrf_(&n, &n, &kd, &kd, ab.data(), &ldab, pivots.data(), &info);
+  EXPECT_EQ(info, 0);
+  MatX x = b;
+  const char trans = 'N';
+  dgbtrs_(&trans, &n, &kd, &kd, &nrhs, ab.data(), &ldab, pivots.data(), x.data(), &n, &info, 1);
+  return x;
+}
+
+// Random band entries; with `zero_diagonal` every diagonal entry is 0, so each column must pivot.
+BandedMatrix RandomBanded(int n, int kd, bool zero_diagonal, std::mt19937* rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  BandedMatrix a(n, kd);
+  const int k = a.half_bandwidth();
+  for (int i = 0; i < n; ++i)
+    for (int j = std::max(0, i - k); j <= std::min(n - 1, i + k); ++j)
+      a(i, j) = (zero_diagonal && i == j) ? 0.0 : u(*rng);
+  return a;
+}
+
+TEST(BandedMatrix, FactorsLikeLapackAndADenseLuForManySizesAndRightHandSides) {
+  std::mt19937 rng(11);
+  for (int n : {1, 2, 5, 10, 11, 12, 21, 40, 130}) {
+    for (int kd : {1, 3, 10}) {
+      for (bool zero_diagonal : {false, true}) {
+        if (zero_diagonal && n == 1) continue;  // a 1×1 zero is singular
+        BandedMatrix a = RandomBanded(n, kd, zero_diagonal, &rng);
+        const MatX dense = a.ToDense();
+        const Eigen::FullPivLU<MatX> reference(dense);
+        if (reference.rank() < n) continue;
+        const MatX b = MatX::Random(n, 7);  // 7 at once: the row-wise path; one by one below
+        const MatX lapack = SolveWithLapack(dense, a.half_bandwidth(), b);
+        ASSERT_TRUE(a.Factorize()) << "n = " << n << ", kd = " << kd;
+        MatX x = b;
+        a.Solve(&x);
+        for (int k = 0; k < b.cols(); ++k) {
+          VecX one = b.col(k);
+          a.Solve(&one);
+          EXPECT_LT((one - lapack.col(k)).norm(), 1e-9 * lapack.col(k).norm()) << "n = " << n;
+        }
+        const double scale = reference.solve(b).norm();
+        // Same pivots, same operations up to their order: agreement near rounding, far below
+        // the dense residual that would reveal a wrong factor.
+        EXPECT_LT((x - lapack).norm(), 1e-9 * scale) << "n = " << n << ", kd = " << kd;
+        EXPECT_LT((dense * x - b).norm(), 1e-10 * b.norm() * (1.0 + dense.norm() * scale))
+            << "n = " << n << ", kd = " << kd;
+      }
+    }
+  }
+}
 
 TEST(BandedMatrix, SolvesLikeADenseLuIncludingIndefiniteMatrices) {
   std::mt19937 rng(7);

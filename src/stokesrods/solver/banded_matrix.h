@@ -1,4 +1,4 @@
-// A square banded matrix with its LU factorization (LAPACK dgbtrf/dgbtrs, partial pivoting).
+// A square banded matrix with its LU factorization (partial pivoting, LAPACK's band storage).
 //
 // The Jacobian of one discrete rod couples only DOFs within one bending stencil
 // (x_{i−1}, θ^{i−1}, x_i, θ^i, x_{i+1}: 11 consecutive entries of q), so its half bandwidth is 10
@@ -55,6 +55,8 @@ class BandedMatrix {
   // LAPACK general band storage with kl = ku = kd and kd extra rows for the fill of pivoting:
   // A(i, j) is stored at ab_[(2kd + i − j) + j · ldab], ldab = 3kd + 1.
   int Index(int i, int j) const { return (2 * kd_ + i - j) + j * ldab_; }
+  // Solve for many right-hand sides at once, on a row-major copy (vectorizes across them).
+  void SolveManyRows(double* b, int num_rhs) const;
 
   int n_ = 0;
   int kd_ = 0;
