@@ -4,11 +4,24 @@
 
 #include <fmt/format.h>
 
+#include <random>
+
+#include "common/helix_lattice.h"
+#include "stokesrods/contact/broad_phase.h"
+#include "stokesrods/contact/segment_distance.h"
 #include "stokesrods/io/build_model.h"
 #include "stokesrods/io/config.h"
 #include "stokesrods/sim/elastic_assembly.h"
 #include "stokesrods/sim/hydro_coupling.h"
 #include "stokesrods/sim/integrator.h"
+
+extern "C" {  // LAPACK's banded LU, the reference BandedMatrix replaced (OpenBLAS)
+void dgbtrf_(const int* m, const int* n, const int* kl, const int* ku, double* ab,
+             const int* ldab, int* ipiv, int* info);
+void dgbtrs_(const char* trans, const int* n, const int* kl, const int* ku, const int* nrhs,
+             const double* ab, const int* ldab, const int* ipiv, double* b, const int* ldb,
+             int* info, std::size_t trans_len);
+}
 
 namespace stokesrods {
 namespace {
@@ -56,6 +69,109 @@ void BM_ElasticForcesAndJacobian(benchmark::State& st) {
 }
 BENCHMARK(BM_ElasticForcesAndJacobian)->RangeMultiplier(4)->Range(64, 4096)
     ->Complexity(benchmark::oN)->Unit(benchmark::kMicrosecond);
+
+// The banded Newton matrix of one rod (N nodes, 4N − 1 DOFs, half bandwidth 10): LU and one solve.
+BandedMatrix RandomRodJacobian(int nodes) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  BandedMatrix a(4 * nodes - 1, 10);
+  for (int i = 0; i < a.size(); ++i)
+    for (int j = std::max(0, i - 10); j <= std::min(a.size() - 1, i + 10); ++j)
+      a(i, j) = (i == j ? 20.0 : 0.0) + u(rng);
+  return a;
+}
+
+void BM_BandedFactorize(benchmark::State& st) {
+  const BandedMatrix a = RandomRodJacobian(static_cast<int>(st.range(0)));
+  for (auto _ : st) {
+    BandedMatrix lu = a;
+    benchmark::DoNotOptimize(lu.Factorize());
+  }
+  st.SetComplexityN(st.range(0));
+}
+BENCHMARK(BM_BandedFactorize)->Arg(65)->Arg(195)->Arg(1025)->Complexity(benchmark::oN)
+    ->Unit(benchmark::kMicrosecond);
+
+void BM_BandedSolve(benchmark::State& st) {
+  BandedMatrix lu = RandomRodJacobian(static_cast<int>(st.range(0)));
+  lu.Factorize();
+  VecX b = VecX::Ones(lu.size());
+  for (auto _ : st) {
+    lu.Solve(&b);
+    benchmark::DoNotOptimize(b.data());
+  }
+  st.SetComplexityN(st.range(0));
+}
+BENCHMARK(BM_BandedSolve)->Arg(65)->Arg(195)->Arg(1025)->Complexity(benchmark::oN)
+    ->Unit(benchmark::kMicrosecond);
+
+// The same with LAPACK (dgbtrf, then dgbtrs for one right-hand side), same storage.
+void BM_BandedLapack(benchmark::State& st, bool solve) {
+  const int nodes = static_cast<int>(st.range(0)), n = 4 * nodes - 1, kd = 10, ldab = 3 * kd + 1;
+  const MatX dense = RandomRodJacobian(nodes).ToDense();
+  std::vector<double> band(static_cast<std::size_t>(ldab) * n, 0.0);
+  for (int j = 0; j < n; ++j)
+    for (int i = std::max(0, j - kd); i <= std::min(n - 1, j + kd); ++i)
+      band[static_cast<std::size_t>(2 * kd + i - j + j * ldab)] = dense(i, j);
+  std::vector<int> pivots(static_cast<std::size_t>(n));
+  std::vector<double> lu = band;
+  int info = 0, one = 1;
+  dgbtrf_(&n, &n, &kd, &kd, lu.data(), &ldab, pivots.data(), &info);
+  VecX b = VecX::Ones(n);
+  const char trans = 'N';
+  for (auto _ : st) {
+    if (solve) {
+      dgbtrs_(&trans, &n, &kd, &kd, &one, lu.data(), &ldab, pivots.data(), b.data(), &n, &info, 1);
+      benchmark::DoNotOptimize(b.data());
+    } else {
+      lu = band;
+      dgbtrf_(&n, &n, &kd, &kd, lu.data(), &ldab, pivots.data(), &info);
+      benchmark::DoNotOptimize(lu.data());
+    }
+  }
+}
+BENCHMARK_CAPTURE(BM_BandedLapack, factorize, false)->Arg(65)->Arg(195)->Arg(1025)
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_BandedLapack, solve, true)->Arg(65)->Arg(195)->Arg(1025)
+    ->Unit(benchmark::kMicrosecond);
+
+// Contact broad phase (uniform grid) on a lattice of k × k helices, against brute force.
+std::vector<Matrix3X> LatticeRods(int k) {
+  const testing::PointCloud c = testing::HelixLattice(k, k);
+  std::vector<Matrix3X> rods;
+  for (int r = 0; r < k * k; ++r) rods.push_back(c.targets.middleCols(65 * r, 65));
+  return rods;
+}
+
+void BroadPhase(benchmark::State& st, bool brute_force) {
+  const std::vector<Matrix3X> rods = LatticeRods(static_cast<int>(st.range(0)));
+  std::vector<const Matrix3X*> pointers;
+  for (const Matrix3X& x : rods) pointers.push_back(&x);
+  std::size_t pairs = 0;
+  for (auto _ : st) {
+    const auto found = brute_force ? FindCandidatePairsBruteForce(pointers, 2e-3, 1)
+                                   : FindCandidatePairs(pointers, 2e-3, 1);
+    pairs = found.size();
+  }
+  st.SetLabel(fmt::format("{} helices, {} candidate pairs", rods.size(), pairs));
+}
+BENCHMARK_CAPTURE(BroadPhase, grid, false)->Arg(2)->Arg(4)->Arg(10)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BroadPhase, brute_force, true)->Arg(2)->Arg(4)->Arg(10)
+    ->Unit(benchmark::kMicrosecond);
+
+// Contact narrow phase: closest points of random segment pairs, per pair.
+void BM_SegmentClosestPoints(benchmark::State& st) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::vector<Vec3> p(4096);
+  for (Vec3& v : p) v = Vec3(n(rng), n(rng), n(rng));
+  std::size_t i = 0;
+  for (auto _ : st) {
+    benchmark::DoNotOptimize(ClosestPointsBetweenSegments(p[i], p[i + 1], p[i + 2], p[i + 3]));
+    i = (i + 4) % p.size();
+  }
+}
+BENCHMARK(BM_SegmentClosestPoints);
 
 // Whole steps from a state already in motion (the first 20 steps are not timed).
 void StepBenchmark(benchmark::State& st, int rods, int nodes, const std::string& fluid,
