@@ -17,8 +17,10 @@
 
 namespace {
 
+// SIGINT/SIGTERM: the first lets the run go on to its next restart point (at most 20 steps) and
+// checkpoint there, so that --resume continues exactly; a second stops after the current step.
 volatile std::sig_atomic_t g_interrupted = 0;
-void OnSignal(int) { g_interrupted = 1; }
+void OnSignal(int) { g_interrupted = g_interrupted + 1; }
 
 std::string Clock(double seconds) {
   const long s = std::lround(std::max(0.0, seconds));
@@ -93,6 +95,7 @@ int main(int argc, char** argv) {
     stokesrods::RunOptions options;
     options.resume = resume;
     options.interrupted = [] { return g_interrupted != 0; };
+    options.stop_now = [] { return g_interrupted > 1; };
     options.progress = ShowProgress;
     const stokesrods::RunResult result = stokesrods::RunCase(config, options);
     switch (result.status) {

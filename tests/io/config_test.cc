@@ -66,7 +66,7 @@ TEST(Config, ErrorsNameTheFileTheKeyAndTheProblem) {
       {"[run]\nmode = \"static\"\n[[rods]]\nbase = [1, 2]\n", "rods.1.base: expected an array of 3 numbers"},
       {"[run]\nmode = \"static\"\n[[rods]]\n[[rods]]\nbase = [0.001, 0, 0]\n",
        "case.toml: rods.2.base: rod 2 overlaps rod 1 at the start"},
-      {"[run\n", "case.toml: line 1:"},
+      {"[run\n", "case.toml: line 1, column 5:"},
   };
   for (const Case& c : cases) {
     // Rod-level cases get a valid [run] so that the rod's own error is the first one.

@@ -47,6 +47,20 @@ FluidModel ParseFluidModel(const std::string& name) {
 }
 
 // RFT coefficients, the LSBT discretization, the stability of the explicit coupling.
+// The node count nearest to `estimate` whose rest shape fits LSBT (at most `allowed` edges off),
+// searched outward from it: the helix's spacing depends on N through its lead-in, so the arc
+// length over Δ alone can miss. 0 if none within 200 of the estimate fits.
+int FittingLsbtNodes(RodConfig rc, int estimate, int allowed) {
+  const int fewest = rc.shape == "helix" ? 5 : 3;
+  for (int offset = 0; offset <= 200; ++offset)
+    for (int n : {estimate - offset, estimate + offset}) {
+      if (n < fewest) continue;
+      rc.nodes = n;
+      if (CheckLsbtDiscretization(RestShape(rc), rc.radius).edges_outside <= allowed) return n;
+    }
+  return 0;
+}
+
 void CheckFluidModel(const Config& config, Model* model) {
   for (std::size_t r = 0; r < model->rods.size(); ++r) {
     RodModel& rod = model->rods[r];
@@ -69,13 +83,18 @@ void CheckFluidModel(const Config& config, Model* model) {
       const LsbtDiscretizationCheck check = CheckLsbtDiscretization(rod.rest_positions, rod.radius);
       // The helix's connecting edge x1 → x2 (length R√2) is part of the paper's geometry.
       const int allowed = rc.shape == "helix" ? 1 : 0;
-      if (check.edges_outside > allowed)
+      if (check.edges_outside > allowed) {
+        const int fits = rc.shape == "points" ? 0 : FittingLsbtNodes(rc, check.suggested_nodes, allowed);
         throw ConfigError(
             config.file, key + ".nodes",
             fmt::format("fluid.model = \"lsbt\" assumes edges of length 2δ = r0√e = {:.4g} m, "
-                        "but {} edges differ by more than 5% (up to {:.0f}%); N = {} fits",
+                        "but {} edges differ by more than 5% (up to {:.0f}%); {}",
                         check.target_edge_length, check.edges_outside,
-                        100.0 * check.max_relative_deviation, check.suggested_nodes));
+                        100.0 * check.max_relative_deviation,
+                        fits > 0 ? fmt::format("nodes = {} fits", fits)
+                                 : std::string("no node count fits this shape and radius (its "
+                                               "edges cannot all be r0√e long)")));
+      }
     }
   }
   if (model->coupling != FluidCoupling::kExplicit ||
@@ -123,6 +142,33 @@ double ExplicitStepLimit(const Model& model) {
     if (l.real() > 0.0) limit = std::min(limit, 2.0 * l.real() / std::norm(l));
   return limit;
 }
+
+namespace {
+
+// A rod whose segments (beyond the self-contact exclusion) are closer than its diameter at rest.
+void CheckSelfOverlap(const Config& config, const Model& model) {
+  for (std::size_t r = 0; r < model.rods.size(); ++r) {
+    const RodConfig& rc = config.rods[r];
+    const std::string key = fmt::format("rods.{}", r + 1);
+    if (rc.shape == "helix" && rc.radius >= rc.helix_radius)
+      throw ConfigError(config.file, key + ".radius",
+                        fmt::format("rod {} overlaps itself: its radius {:.4g} m is not smaller "
+                                    "than helix_radius {:.4g} m",
+                                    r + 1, rc.radius, rc.helix_radius));
+    Model alone;
+    alone.rods = {model.rods[r]};
+    alone.newton.contact_tolerance = 0.0;
+    FinalizeLayout(&alone);
+    const ContactSummary contacts = MeasureContacts(alone, MakeRestState(alone).q);
+    if (contacts.detected > 0)
+      throw ConfigError(config.file, key + (rc.shape == "helix" ? ".pitch" : ".points"),
+                        fmt::format("rod {} overlaps itself at the start: two of its segments are "
+                                    "{:.4g} m closer than its diameter {:.4g} m",
+                                    r + 1, contacts.max_penetration, 2.0 * rc.radius));
+  }
+}
+
+}  // namespace
 
 Model BuildModel(const Config& config) {
   Model model;
@@ -189,6 +235,7 @@ Model BuildModel(const Config& config) {
 
   CheckFluidModel(config, &model);
 
+  CheckSelfOverlap(config, model);
   // Rods overlapping at the start.
   std::vector<Eigen::AlignedBox3d> boxes;
   for (const RodModel& rod : model.rods) {
@@ -214,6 +261,38 @@ Model BuildModel(const Config& config) {
   return model;
 }
 
+namespace {
+
+// The run in steps, checked: every count is a whole, representable number of steps ≥ 1.
+void SetStepCounts(const Config& config, RunPlan* plan) {
+  const double h = plan->time_step;
+  const std::string duration_key = config.run.duration ? "run.duration" : "run.t_bar_end";
+  const double steps = std::ceil(plan->duration / h - 1e-9);
+  if (!(steps <= kMaxSteps))
+    throw ConfigError(config.file, "run.time_step",
+                      fmt::format("the run would take {:.3g} steps ({} gives {:.3g} s, "
+                                  "run.time_step = {:.3g} s; at most {:.0e} steps)",
+                                  plan->duration / h, duration_key, plan->duration, h, kMaxSteps));
+  if (h > plan->duration * (1.0 + 1e-9))
+    throw ConfigError(config.file, "run.time_step",
+                      fmt::format("{:.6g} s is longer than the whole run ({:.6g} s)", h,
+                                  plan->duration));
+  auto check_interval = [&](const char* key, double interval, bool given) {
+    if (h > interval * (1.0 + 1e-9))
+      throw ConfigError(config.file, given ? key : "run.time_step",
+                        fmt::format("{} = {:.6g} s is shorter than run.time_step = {:.6g} s", key,
+                                    interval, h));
+  };
+  check_interval("run.output_interval", plan->output_interval, config.run.output_interval.has_value());
+  check_interval("run.checkpoint_interval", plan->checkpoint_interval,
+                 config.run.checkpoint_interval.has_value());
+  plan->total_steps = std::max(1L, static_cast<long>(steps));
+  plan->output_every = std::max(1L, std::lround(plan->output_interval / h));
+  plan->checkpoint_every = std::max(1L, std::lround(plan->checkpoint_interval / h));
+}
+
+}  // namespace
+
 RunPlan MakeRunPlan(const Config& config, const Model& model) {
   RunPlan plan;
   plan.name = config.run.name;
@@ -231,6 +310,8 @@ RunPlan MakeRunPlan(const Config& config, const Model& model) {
   plan.checkpoint_interval = config.run.checkpoint_interval
                                  ? *config.run.checkpoint_interval
                                  : std::max(plan.time_step, plan.duration / 10.0);
+  plan.checkpoint_wall_interval = config.run.checkpoint_wall_interval.value_or(0.0);
+  if (!plan.static_mode) SetStepCounts(config, &plan);
   return plan;
 }
 
@@ -258,7 +339,7 @@ std::string DerivedJson(const Config& config, const Model& model) {
   d["t_bar_end"] = plan.duration / scales.time;
   d["output_interval"] = plan.output_interval;
   d["checkpoint_interval"] = plan.checkpoint_interval;
-  d["steps"] = plan.static_mode ? 0.0 : std::ceil(plan.duration / plan.time_step - 1e-9);
+  d["steps"] = plan.total_steps;
   return d.dump(2);
 }
 

@@ -17,8 +17,16 @@ struct RunPlan {
   double time_step = 0.0;            ///< [s]
   double output_interval = 0.0;      ///< [s]
   double checkpoint_interval = 0.0;  ///< [s]
+  double checkpoint_wall_interval = 0.0;  ///< [s] of wall time (0: every checkpoint_interval)
   bool frames = true;
+  // The same in steps of time_step (dynamic runs).
+  long total_steps = 0;
+  long output_every = 1;
+  long checkpoint_every = 1;
 };
+
+/// The most steps a run may take (a larger count is a typo in time_step or duration).
+constexpr double kMaxSteps = 1e12;
 
 /// Builds the model. Throws ConfigError for input that is well-typed but physically unusable
 /// (rods overlapping at the start, a model not available, ...).
@@ -29,6 +37,8 @@ Model BuildModel(const Config& config);
 /// M⁻¹ (𝕄⁻¹)_ff, about 2 m/c for node mass m and node drag coefficient c).
 double ExplicitStepLimit(const Model& model);
 
+/// Throws ConfigError for a dynamic run whose step count overflows or is zero, whose time step
+/// exceeds the duration or the output or checkpoint interval.
 RunPlan MakeRunPlan(const Config& config, const Model& model);
 
 /// The derived quantities as a JSON object text: EI, GJ, EA per rod, time_scale, omega and

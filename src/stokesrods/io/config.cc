@@ -29,6 +29,7 @@ void VisitFields(RunConfig& c, V& v) {
   v("output_interval", c.output_interval);
   v("frames", c.frames);
   v("checkpoint_interval", c.checkpoint_interval);
+  v("checkpoint_wall_interval", c.checkpoint_wall_interval);
 }
 template <class V>
 void VisitFields(FluidConfig& c, V& v) {
@@ -356,7 +357,8 @@ Config ParseConfig(const std::string& toml_text, const std::string& file,
   try {
     root = toml::parse(toml_text, file);
   } catch (const toml::parse_error& e) {
-    throw ConfigError(file, fmt::format("line {}", e.source().begin.line),
+    throw ConfigError(file, fmt::format("line {}, column {}", e.source().begin.line,
+                                        e.source().begin.column),
                       std::string(e.description()));
   }
   for (const std::string& o : overrides) ApplyOverride(&root, o, file);

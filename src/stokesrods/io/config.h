@@ -36,6 +36,9 @@ struct RunConfig {
   std::optional<double> output_interval;  ///< [s], default: 1/100 of the run
   bool frames = true;
   std::optional<double> checkpoint_interval;  ///< [s], default: 1/10 of the run
+  /// [s] of wall time: if set, a checkpoint is written at the first restart point (every 20 steps
+  /// and every checkpoint_interval) after this much wall time since the last one
+  std::optional<double> checkpoint_wall_interval;
 };
 
 struct FluidConfig {

@@ -106,6 +106,8 @@ void ValidateConfig(Config* config) {
   }
   if (run.output_interval) c.Positive("run.output_interval", *run.output_interval);
   if (run.checkpoint_interval) c.Positive("run.checkpoint_interval", *run.checkpoint_interval);
+  if (run.checkpoint_wall_interval)
+    c.Positive("run.checkpoint_wall_interval", *run.checkpoint_wall_interval);
 
   c.OneOf("fluid.model", config->fluid.model, {"rss", "lsbt", "rft", "none"});
   c.OneOf("fluid.coupling", config->fluid.coupling, {"implicit", "explicit"});

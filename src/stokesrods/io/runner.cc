@@ -4,13 +4,13 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
+#include <optional>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "stokesrods/io/build_model.h"
+#include "stokesrods/io/checkpoint.h"
 #include "stokesrods/io/flow_field.h"
 #include "stokesrods/io/writers.h"
 #include "stokesrods/sim/integrator.h"
@@ -26,32 +26,23 @@ const char* StatusName(RunStatus s) {
   return s == RunStatus::kCompleted ? "completed" : s == RunStatus::kFailed ? "failed" : "interrupted";
 }
 
-// Keeps the rows of an existing timeseries.csv up to time t (for --resume); false if none.
-bool TruncateTimeseries(const std::string& path, double t) {
-  std::ifstream in(path);
-  if (!in) return false;
-  std::string line, kept;
-  std::getline(in, line);
-  kept = line + "\n";
-  while (std::getline(in, line)) {
-    if (std::stod(line.substr(0, line.find(','))) > t * (1.0 + 1e-12)) break;
-    kept += line + "\n";
-  }
-  WriteFileAtomically(path, kept);
-  return true;
-}
-
 class Observer {
  public:
-  Observer(const Config& config, const Model& model, const RunPlan& plan, bool append)
+  /// `kept_rows` > 0 (--resume): the rows (and frames) of the earlier run that are kept.
+  Observer(const Config& config, const Model& model, const RunPlan& plan, long kept_rows)
       : config_(config), model_(model), plan_(plan), columns_(TimeseriesColumns(model)),
-        csv_((fs::path(plan.output_dir) / "timeseries.csv").string(), columns_, append) {
-    if (plan.frames) frames_.emplace(plan.output_dir);
+        csv_(PrepareCsv((fs::path(plan.output_dir) / "timeseries.csv").string(), kept_rows),
+             columns_, kept_rows > 0) {
+    if (plan.frames) frames_.emplace(plan.output_dir, kept_rows);
   }
 
   void Record(const State& state, const Workspace& ws, const StepReport& report) {
     last_row_ = CalcTimeseriesRow(model_, state, ws, report);
     csv_.WriteRow(last_row_);
+    WriteFrame(state, ws);
+  }
+
+  void WriteFrame(const State& state, const Workspace& ws) {
     if (frames_) {
       VecX hydro = ws.nonlocal_fluid ? ws.hydro_force : VecX();
       VecX contact = VecX::Zero(3 * model_.num_nodes);
@@ -77,12 +68,18 @@ class Observer {
     s["max_penetration"] = max_penetration;
     s["steps"] = result.steps;
     s["newton_iterations"] = result.newton_iterations;
+    s["step_reductions"] = result.step_reductions;
     s["wall_seconds"] = result.wall_seconds;
     s["version"] = STOKESRODS_VERSION;
     WriteFileAtomically((fs::path(plan_.output_dir) / "summary.json").string(), s.dump(2) + "\n");
   }
 
  private:
+  static std::string PrepareCsv(const std::string& path, long kept_rows) {
+    if (kept_rows > 0) TruncateCsv(path, kept_rows);
+    return path;
+  }
+
   const Config& config_;
   const Model& model_;
   const RunPlan& plan_;
@@ -91,6 +88,42 @@ class Observer {
   std::optional<FrameWriter> frames_;
   std::vector<double> last_row_;
 };
+
+
+// The schedule of a dynamic run, in steps.
+struct Schedule {
+  const RunPlan& plan;
+
+  bool Records(long step) const { return step % plan.output_every == 0 || step == plan.total_steps; }
+  bool IsCheckpointStep(long step) const { return step % plan.checkpoint_every == 0; }
+  bool IsRestartPoint(long step) const { return step % kRestartSteps == 0 || IsCheckpointStep(step); }
+  /// Rows of timeseries.csv (and frames) an uninterrupted run has written once it is at `step`.
+  long RowsThrough(long step) const {
+    return 1 + step / plan.output_every +
+           (step == plan.total_steps && step % plan.output_every != 0 ? 1 : 0);
+  }
+};
+
+// Resume: the checkpoint into the state, the workspace and the counters; returns the rows kept.
+long Resume(const Config& config, const Model& model, const RunPlan& plan,
+            const std::string& path, State* state, Workspace* ws, RunCounters* counters) {
+  if (plan.static_mode) throw ConfigError(config.file, "run.mode", "--resume needs a dynamic run");
+  if (!fs::exists(path)) throw IoError(fmt::format("{}: no checkpoint to resume from", path));
+  Checkpoint c = LoadCheckpoint(path, model);
+  if (c.time_step != plan.time_step)
+    throw ConfigError(config.file, "run.time_step",
+                      fmt::format("{} was written with run.time_step = {:.17g} s; resume with the "
+                                  "same (got {:.17g} s) or start a new run",
+                                  path, c.time_step, plan.time_step));
+  if (c.state.step > plan.total_steps)
+    throw ConfigError(config.file, config.run.duration ? "run.duration" : "run.t_bar_end",
+                      fmt::format("{} is at t = {:.6g} s, past the end of this run ({:.6g} s)",
+                                  path, c.state.time, plan.duration));
+  *state = std::move(c.state);
+  RestoreHistory(c.history, ws);
+  *counters = c.counters;
+  return Schedule{plan}.RowsThrough(state->step);
+}
 
 }  // namespace
 
@@ -107,18 +140,13 @@ RunResult RunCase(const Config& config, const RunOptions& options) {
   const std::string checkpoint = (fs::path(plan.output_dir) / "checkpoint.bin").string();
 
   State state = MakeRestState(model);
-  bool append = false;
-  if (options.resume) {
-    if (!fs::exists(checkpoint))
-      throw IoError(fmt::format("{}: no checkpoint to resume from", checkpoint));
-    state = LoadCheckpoint(checkpoint, model);
-    append = TruncateTimeseries((fs::path(plan.output_dir) / "timeseries.csv").string(), state.time);
-  }
   Workspace ws(model);
-  Observer observer(config, model, plan, append);
+  RunCounters counters;
+  const long kept_rows =
+      options.resume ? Resume(config, model, plan, checkpoint, &state, &ws, &counters) : 0;
+  Observer observer(config, model, plan, kept_rows);
   RunResult result;
   result.output_dir = plan.output_dir;
-  double max_penetration = 0.0;
   StepReport report;
   report.ok = true;
 
@@ -134,10 +162,13 @@ RunResult RunCase(const Config& config, const RunOptions& options) {
   }
 
   const double h = plan.time_step;
-  const long total_steps = std::lround(std::ceil(plan.duration / h - 1e-9));
-  const long output_every = std::max(1L, std::lround(plan.output_interval / h));
-  const long checkpoint_every = std::max(1L, std::lround(plan.checkpoint_interval / h));
-  if (!append) {
+  const Schedule schedule{plan};
+  long saved_step = -1;
+  auto save_checkpoint = [&] {
+    SaveCheckpoint(checkpoint, model, {state, CaptureHistory(ws), counters, h});
+    saved_step = state.step;
+  };
+  if (kept_rows == 0) {
     report.contact = model.contact ? MeasureContacts(model, state.q) : ContactSummary{};
     // Forces of the rest state for the first row: one static evaluation is not needed, the rest
     // state has zero elastic force and no velocity.
@@ -146,44 +177,65 @@ RunResult RunCase(const Config& config, const RunOptions& options) {
   // Flow planes: at the first step that reaches each requested time.
   std::vector<double> flow_times = config.flow_field.times;
   std::sort(flow_times.begin(), flow_times.end());
-  std::size_t next_flow = 0;
-  while (next_flow < flow_times.size() && flow_times[next_flow] < state.time - 0.5 * h) ++next_flow;
+  std::size_t next_flow = 0;  // on resume: past those the steps up to the checkpoint wrote
+  while (kept_rows > 0 && next_flow < flow_times.size() && flow_times[next_flow] <= state.time + 0.5 * h)
+    ++next_flow;
   auto write_flow = [&] {
     while (next_flow < flow_times.size() && flow_times[next_flow] <= state.time + 0.5 * h) {
       WriteFlowField(model, state, config.flow_field, plan.output_dir, static_cast<int>(next_flow));
       ++next_flow;
     }
   };
-  write_flow();
-  double last_progress = -1.0;
-  while (state.step < total_steps) {
-    if (options.interrupted && options.interrupted()) {
+  if (kept_rows == 0) {
+    write_flow();
+    save_checkpoint();  // step 0 is a restart point: a run always has a checkpoint
+  }
+  double last_progress = -1.0, last_checkpoint = 0.0;
+  bool stopping = false;
+  while (state.step < plan.total_steps) {
+    stopping = stopping || (options.interrupted && options.interrupted());
+    const bool stop_now = options.stop_now && options.stop_now();
+    if ((stopping && schedule.IsRestartPoint(state.step)) || stop_now) {
+      if (!stop_now && saved_step != state.step) save_checkpoint();
       result.status = RunStatus::kInterrupted;
       result.message = fmt::format("interrupted at t = {:.6g} s", state.time);
       break;
     }
     report = Step(model, h, &state, &ws);
-    result.newton_iterations += report.newton_iterations;
+    counters.newton_iterations += report.newton_iterations;
     if (!report.ok) {
       result.status = RunStatus::kFailed;
-      result.message = report.message + "; the last good state is in " + checkpoint;
+      result.message = report.message + "; the last good state is in " + checkpoint +
+                       (plan.frames ? " and the last frame" : "");
+      observer.WriteFrame(state, ws);
+      save_checkpoint();
       break;
     }
-    ++result.steps;
-    max_penetration = std::max(max_penetration, report.contact.max_penetration);
-    if (state.step % output_every == 0 || state.step == total_steps) observer.Record(state, ws, report);
-    if (state.step % checkpoint_every == 0) SaveCheckpoint(checkpoint, state);
+    counters.max_penetration = std::max(counters.max_penetration, report.contact.max_penetration);
+    if (schedule.Records(state.step)) observer.Record(state, ws, report);
     write_flow();
+    if (schedule.IsRestartPoint(state.step)) {
+      ForgetReuse(&ws);
+      const bool due = plan.checkpoint_wall_interval > 0.0
+                           ? wall() - last_checkpoint >= plan.checkpoint_wall_interval
+                           : schedule.IsCheckpointStep(state.step);
+      if (due || state.step == plan.total_steps) {
+        save_checkpoint();
+        last_checkpoint = wall();
+      }
+    }
     if (options.progress && wall() - last_progress >= 0.2) {
       last_progress = wall();
       options.progress({state.time, plan.duration, last_progress, state.step});
     }
   }
-  SaveCheckpoint(checkpoint, state);
+  // A run that ends off the restart points keeps the last one as its checkpoint (a longer run
+  // resumed from it continues exactly); its final state is in the last row and frame.
   result.steps = state.step;
+  result.newton_iterations = counters.newton_iterations;
   result.wall_seconds = wall();
   if (options.progress) options.progress({state.time, plan.duration, result.wall_seconds, state.step});
-  observer.WriteSummary(result.status, result.message, result, max_penetration);
+  observer.WriteSummary(result.status, result.message, result, counters.max_penetration);
   return result;
 }
 

@@ -20,9 +20,19 @@ struct RunProgress {
 
 struct RunOptions {
   bool resume = false;                              ///< continue from the last checkpoint
-  std::function<bool()> interrupted;                ///< polled every step (e.g. SIGINT seen)
+  /// Polled every step (e.g. SIGINT seen): the run goes on to the next restart point (at most 20
+  /// steps), writes a checkpoint there and stops, so that --resume continues it exactly.
+  std::function<bool()> interrupted;
+  /// Polled every step (e.g. a second SIGINT): stop after the current step; checkpoint.bin keeps
+  /// the last restart point.
+  std::function<bool()> stop_now;
   std::function<void(const RunProgress&)> progress; ///< called about every 0.2 s of wall time
 };
+
+/// Restart points: after every kRestartSteps-th step and every checkpoint step a run forgets the
+/// factors it reuses across steps (sim/integrator.h ForgetReuse), so that a run resumed there
+/// continues bit for bit. 20 is the Krylov preconditioner's own largest age: no extra rebuilds.
+constexpr long kRestartSteps = 20;
 
 struct RunResult {
   RunStatus status = RunStatus::kCompleted;
@@ -30,6 +40,7 @@ struct RunResult {
   std::string output_dir;
   long steps = 0;
   long newton_iterations = 0;
+  long step_reductions = 0;  ///< steps retried at h/2 (solver.max_step_halvings)
   double wall_seconds = 0.0;
 };
 

@@ -52,7 +52,46 @@ void WriteFileAtomically(const std::string& path, const std::string& text) {
   if (ec) throw IoError(fmt::format("{}: cannot rename into place: {}", path, ec.message()));
 }
 
-FrameWriter::FrameWriter(const std::string& output_dir) : dir_(output_dir) {
+namespace {
+
+// The first `count` lines of a text file that start with `prefix` (after blanks); IoError if
+// there are fewer.
+std::vector<std::string> LeadingLines(const std::string& path, const std::string& prefix,
+                                      long count) {
+  std::vector<std::string> lines;
+  if (count <= 0) return lines;
+  std::ifstream in(path);
+  if (!in) throw IoError(fmt::format("{}: cannot resume: the file is missing", path));
+  for (std::string line; lines.size() < static_cast<std::size_t>(count) && std::getline(in, line);) {
+    const std::size_t start = line.find_first_not_of(" \t");
+    if (start != std::string::npos && line.compare(start, prefix.size(), prefix) == 0)
+      lines.push_back(line);
+  }
+  if (lines.size() < static_cast<std::size_t>(count))
+    throw IoError(fmt::format("{}: cannot resume: it has {} entries, the checkpoint needs {}", path,
+                              lines.size(), count));
+  return lines;
+}
+
+}  // namespace
+
+void TruncateCsv(const std::string& path, long rows) {
+  std::string header;
+  std::ifstream in(path);
+  if (!in) throw IoError(fmt::format("{}: cannot resume: the file is missing", path));
+  std::getline(in, header);
+  std::string text = header + "\n";
+  long kept = 0;
+  for (std::string line; kept < rows && std::getline(in, line); ++kept) text += line + "\n";
+  if (kept < rows)
+    throw IoError(fmt::format("{}: cannot resume: it has {} rows, the checkpoint needs {}", path,
+                              kept, rows));
+  WriteFileAtomically(path, text);
+}
+
+FrameWriter::FrameWriter(const std::string& output_dir, long keep)
+    : dir_(output_dir),
+      entries_(LeadingLines((fs::path(output_dir) / "rods.pvd").string(), "<DataSet ", keep)) {
   std::error_code ec;
   fs::create_directories(fs::path(dir_) / "frames", ec);
   if (ec) throw IoError(fmt::format("{}/frames: cannot create: {}", dir_, ec.message()));
@@ -60,7 +99,7 @@ FrameWriter::FrameWriter(const std::string& output_dir) : dir_(output_dir) {
 
 void FrameWriter::Write(const Model& model, const State& state,
                         const std::vector<FramePointData>& data) {
-  const std::string name = fmt::format("frames/rods_{:05d}.vtp", frames_.size());
+  const std::string name = fmt::format("frames/rods_{:05d}.vtp", entries_.size());
   std::string xml;
   xml += "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n<PolyData>\n";
   xml += fmt::format("<Piece NumberOfPoints=\"{}\" NumberOfLines=\"{}\">\n", model.num_nodes,
@@ -92,81 +131,13 @@ void FrameWriter::Write(const Model& model, const State& state,
   }
   xml += "</PointData>\n</Piece>\n</PolyData>\n</VTKFile>\n";
   WriteFileAtomically((fs::path(dir_) / name).string(), xml);
-  frames_.emplace_back(state.time, name);
+  entries_.push_back(
+      fmt::format("<DataSet timestep=\"{:.10g}\" part=\"0\" file=\"{}\"/>", state.time, name));
 
   std::string pvd = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
-  for (const auto& [t, file] : frames_)
-    pvd += fmt::format("<DataSet timestep=\"{:.10g}\" part=\"0\" file=\"{}\"/>\n", t, file);
+  for (const std::string& entry : entries_) pvd += entry + "\n";
   pvd += "</Collection>\n</VTKFile>\n";
   WriteFileAtomically((fs::path(dir_) / "rods.pvd").string(), pvd);
-}
-
-namespace {
-constexpr char kMagic[8] = {'S', 'R', 'C', 'K', 'P', 'T', '0', '1'};
-
-void Put(std::string* out, const void* data, std::size_t bytes) {
-  out->append(static_cast<const char*>(data), bytes);
-}
-void PutVec(std::string* out, const VecX& v) {
-  const std::int64_t n = v.size();
-  Put(out, &n, sizeof n);
-  Put(out, v.data(), sizeof(double) * static_cast<std::size_t>(n));
-}
-}  // namespace
-
-void SaveCheckpoint(const std::string& path, const State& state) {
-  std::string out(kMagic, sizeof kMagic);
-  Put(&out, &state.time, sizeof state.time);
-  Put(&out, &state.step, sizeof state.step);
-  PutVec(&out, state.q);
-  PutVec(&out, state.velocity);
-  for (const RodFrames& rod : state.rods) {
-    for (std::size_t j = 0; j < rod.frames.size(); ++j) {
-      Put(&out, rod.frames[j].d1.data(), 3 * sizeof(double));
-      Put(&out, rod.frames[j].d2.data(), 3 * sizeof(double));
-      Put(&out, rod.tangents[j].data(), 3 * sizeof(double));
-    }
-    PutVec(&out, rod.reference_twist);
-  }
-  WriteFileAtomically(path, out);
-}
-
-State LoadCheckpoint(const std::string& path, const Model& model) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(fmt::format("{}: cannot open the checkpoint", path));
-  auto get = [&](void* data, std::size_t bytes) {
-    in.read(static_cast<char*>(data), static_cast<std::streamsize>(bytes));
-    if (!in) throw IoError(fmt::format("{}: truncated checkpoint", path));
-  };
-  auto get_vec = [&](VecX* v, Eigen::Index expected) {
-    std::int64_t n = 0;
-    get(&n, sizeof n);
-    if (n != expected) throw IoError(fmt::format("{}: checkpoint does not match the model", path));
-    v->resize(n);
-    get(v->data(), sizeof(double) * static_cast<std::size_t>(n));
-  };
-  char magic[8];
-  get(magic, sizeof magic);
-  if (std::memcmp(magic, kMagic, sizeof kMagic) != 0)
-    throw IoError(fmt::format("{}: not a stokesrods checkpoint", path));
-  State state;
-  get(&state.time, sizeof state.time);
-  get(&state.step, sizeof state.step);
-  get_vec(&state.q, model.num_dofs);
-  get_vec(&state.velocity, model.num_dofs);
-  for (const RodModel& rod : model.rods) {
-    RodFrames f;
-    f.frames.resize(rod.num_nodes() - 1);
-    f.tangents.resize(rod.num_nodes() - 1);
-    for (int j = 0; j + 1 < rod.num_nodes(); ++j) {
-      get(f.frames[j].d1.data(), 3 * sizeof(double));
-      get(f.frames[j].d2.data(), 3 * sizeof(double));
-      get(f.tangents[j].data(), 3 * sizeof(double));
-    }
-    get_vec(&f.reference_twist, rod.num_nodes());
-    state.rods.push_back(std::move(f));
-  }
-  return state;
 }
 
 }  // namespace stokesrods

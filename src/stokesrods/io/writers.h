@@ -42,19 +42,21 @@ struct FramePointData {
 /// frame so ParaView can open a run while it goes.
 class FrameWriter {
  public:
-  explicit FrameWriter(const std::string& output_dir);
+  /// `keep`: frames of an earlier run kept (--resume): the first `keep` entries of its rods.pvd,
+  /// which must have them; the next frame is number `keep`.
+  explicit FrameWriter(const std::string& output_dir, long keep = 0);
   void Write(const Model& model, const State& state, const std::vector<FramePointData>& data);
 
  private:
   std::string dir_;
-  std::vector<std::pair<double, std::string>> frames_;
+  std::vector<std::string> entries_;  ///< the DataSet lines of rods.pvd
 };
+
+/// Keeps the header and the first `rows` rows of an existing CSV file (--resume); IoError if it
+/// has fewer.
+void TruncateCsv(const std::string& path, long rows);
 
 /// Writes text to `path` through a temporary file and a rename (never a half-written file).
 void WriteFileAtomically(const std::string& path, const std::string& text);
-
-/// Checkpoint: the whole State, binary, written atomically.
-void SaveCheckpoint(const std::string& path, const State& state);
-State LoadCheckpoint(const std::string& path, const Model& model);
 
 }  // namespace stokesrods

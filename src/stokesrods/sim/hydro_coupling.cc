@@ -85,6 +85,18 @@ HydroSolveReport HydroCoupling::Prepare(const Model& model, const VecX& q_start,
   return report;
 }
 
+void HydroCoupling::ForgetReuse(const VecX& drag_guess) {
+  have_preconditioner_ = false;
+  preconditioner_h_ = -1.0;
+  preconditioner_age_ = 0;
+  iterations_after_refresh_ = -1;
+  wants_refresh_ = false;
+  mobility_changed_ = true;
+  explicit_blocks_.reset();
+  explicit_blocks_age_ = 0;
+  explicit_force_ = drag_guess;
+}
+
 void HydroCoupling::AddNodalForce(const Model& model, const VecX& f, VecX* force) {
   for (const RodModel& rod : model.rods)
     for (int i = 0; i < rod.num_nodes(); ++i)

@@ -79,6 +79,11 @@ class HydroCoupling {
   /// built). The integrator then rebuilds the Newton factors.
   bool wants_refresh() const { return wants_refresh_ || (!krylov_ && mobility_changed_); }
 
+  /// Forgets the preconditioners kept across steps, as a fresh HydroCoupling would have none,
+  /// and takes `drag_guess` (3M, or empty) as the explicit drag's first GMRES guess. After it the
+  /// next steps depend only on the state and the guess: the point a checkpoint resumes from.
+  void ForgetReuse(const VecX& drag_guess);
+
   const MobilityOperator& mobility() const { return *mobility_; }
   /// The worst Krylov solve since the last call to ResetSolveReport (for failure messages).
   const HydroSolveReport& worst_solve() const { return worst_solve_; }

@@ -22,6 +22,27 @@ Workspace::Workspace(const Model& model) : local_forces(MakeLocalForces(model)) 
   }
 }
 
+StepHistory CaptureHistory(const Workspace& ws) {
+  return {ws.previous_q, ws.previous_velocity, ws.previous_h,
+          ws.nonlocal_fluid ? ws.hydro_force : VecX()};
+}
+
+void RestoreHistory(const StepHistory& history, Workspace* ws) {
+  ws->previous_q = history.previous_q;
+  ws->previous_velocity = history.previous_velocity;
+  ws->previous_h = history.previous_h;
+  if (ws->nonlocal_fluid) ws->hydro_force = history.hydro_force;
+  ForgetReuse(ws);
+}
+
+void ForgetReuse(Workspace* ws) {
+  ws->factors_valid = false;
+  ws->factors_h = -1.0;
+  ws->factors_age = 0;
+  ws->last_iterations = 0;
+  if (ws->nonlocal_fluid) ws->hydro.ForgetReuse(ws->hydro_force);
+}
+
 void DriveBoundaryConditions(const Model& model, double h, VecX* q) {
   for (const RodModel& rod : model.rods)
     if (rod.clamped_nodes >= 2) (*q)(rod.dof_offset + TwistDof(0)) += h * rod.twist_rate;

@@ -74,6 +74,23 @@ struct Workspace {
   int last_iterations = 0;       ///< Newton iterations of the last converged solve
 };
 
+/// What the next step reads from the steps before it, besides the State: BDF2's history and the
+/// drag's first guess. A checkpoint saves it with the State (io/checkpoint.h).
+struct StepHistory {
+  VecX previous_q;          ///< q(t_{k−1}) (empty before the first step)
+  VecX previous_velocity;   ///< q̇(t_{k−1})
+  double previous_h = 0.0;  ///< [s]
+  VecX hydro_force;         ///< the nodal drag of the last step (3M; empty without a nonlocal fluid)
+};
+StepHistory CaptureHistory(const Workspace& ws);
+void RestoreHistory(const StepHistory& history, Workspace* ws);
+
+/// Forgets every factorization and preconditioner kept across steps (the Newton matrix and its
+/// age, the Krylov preconditioner of the drag): the next step rebuilds them, as it would in a
+/// fresh Workspace. A run calls it at each checkpoint, so that a run resumed from the checkpoint
+/// (a fresh Workspace with the saved StepHistory) steps exactly as the uninterrupted one.
+void ForgetReuse(Workspace* ws);
+
 /// What depends on the start of a step only: the local forces' caches, the mobility 𝕄 at q_k (and
 /// the explicit drag), the contact force reset. Step calls it; Evaluate needs it first.
 void PrepareStep(const Model& model, const State& start, Workspace* ws);

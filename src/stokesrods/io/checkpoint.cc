@@ -1,0 +1,169 @@
+#include "stokesrods/io/checkpoint.h"
+
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "stokesrods/io/writers.h"
+
+namespace stokesrods {
+namespace {
+
+constexpr char kMagic[8] = {'S', 'R', 'C', 'K', 'P', 'T', '\0', '\0'};
+constexpr std::uint32_t kVersion = 2;
+
+std::uint64_t Fnv1a(const char* data, std::size_t bytes, std::uint64_t hash = 14695981039346656037ull) {
+  for (std::size_t i = 0; i < bytes; ++i) {
+    hash ^= static_cast<unsigned char>(data[i]);
+    hash *= 1099511628211ull;
+  }
+  return hash;
+}
+
+class Writer {
+ public:
+  template <typename T>
+  void Put(const T& value) { Raw(&value, sizeof value); }
+  void Raw(const void* data, std::size_t bytes) { out_.append(static_cast<const char*>(data), bytes); }
+  void Vector(const VecX& v) {
+    Put(static_cast<std::int64_t>(v.size()));
+    Raw(v.data(), sizeof(double) * static_cast<std::size_t>(v.size()));
+  }
+  std::string& text() { return out_; }
+
+ private:
+  std::string out_;
+};
+
+class Reader {
+ public:
+  Reader(const std::string& path, const std::string& text) : path_(path), text_(text) {}
+  template <typename T>
+  T Get() {
+    T value;
+    Raw(&value, sizeof value);
+    return value;
+  }
+  void Raw(void* data, std::size_t bytes) {
+    if (bytes > text_.size() - at_) Fail("truncated");
+    std::memcpy(data, text_.data() + at_, bytes);
+    at_ += bytes;
+  }
+  /// A vector of `expected` entries, or (allow_empty) none.
+  VecX Vector(Eigen::Index expected, const char* what, bool allow_empty = false) {
+    const auto n = Get<std::int64_t>();
+    if (n != expected && !(allow_empty && n == 0))
+      Fail(fmt::format("{} has {} entries, the model needs {}", what, n, expected));
+    VecX v(n);
+    Raw(v.data(), sizeof(double) * static_cast<std::size_t>(n));
+    return v;
+  }
+  [[noreturn]] void Fail(const std::string& problem) const {
+    throw IoError(fmt::format("{}: cannot resume from this checkpoint: {}", path_, problem));
+  }
+  std::size_t at() const { return at_; }
+
+ private:
+  const std::string& path_;
+  const std::string& text_;
+  std::size_t at_ = 0;
+};
+
+}  // namespace
+
+std::uint64_t ModelFingerprint(const Model& model) {
+  Writer w;
+  w.Put(static_cast<std::int64_t>(model.num_dofs));
+  for (const RodModel& rod : model.rods) {
+    w.Put(static_cast<std::int64_t>(rod.num_nodes()));
+    w.Raw(rod.rest_positions.data(), sizeof(double) * static_cast<std::size_t>(rod.rest_positions.size()));
+    w.Vector(rod.mass);
+    w.Put(rod.axial_stiffness);
+    w.Put(rod.bending_stiffness);
+    w.Put(rod.twisting_stiffness);
+  }
+  return Fnv1a(w.text().data(), w.text().size());
+}
+
+void SaveCheckpoint(const std::string& path, const Model& model, const Checkpoint& c) {
+  Writer w;
+  w.Raw(kMagic, sizeof kMagic);
+  w.Put(kVersion);
+  w.Put(ModelFingerprint(model));
+  w.Put(c.time_step);
+  w.Put(c.state.time);
+  w.Put(static_cast<std::int64_t>(c.state.step));
+  w.Vector(c.state.q);
+  w.Vector(c.state.velocity);
+  for (const RodFrames& rod : c.state.rods) {
+    for (std::size_t j = 0; j < rod.frames.size(); ++j) {
+      w.Raw(rod.frames[j].d1.data(), 3 * sizeof(double));
+      w.Raw(rod.frames[j].d2.data(), 3 * sizeof(double));
+      w.Raw(rod.tangents[j].data(), 3 * sizeof(double));
+    }
+    w.Vector(rod.reference_twist);
+  }
+  w.Vector(c.history.previous_q);
+  w.Vector(c.history.previous_velocity);
+  w.Put(c.history.previous_h);
+  w.Vector(c.history.hydro_force);
+  w.Put(static_cast<std::int64_t>(c.counters.newton_iterations));
+  w.Put(c.counters.max_penetration);
+  w.Put(Fnv1a(w.text().data(), w.text().size()));
+  WriteFileAtomically(path, w.text());
+}
+
+Checkpoint LoadCheckpoint(const std::string& path, const Model& model) {
+  std::string text;
+  {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw IoError(fmt::format("{}: cannot open the checkpoint", path));
+    std::stringstream s;
+    s << in.rdbuf();
+    text = s.str();
+  }
+  Reader r(path, text);
+  char magic[sizeof kMagic];
+  if (text.size() < sizeof kMagic || (r.Raw(magic, sizeof magic), std::memcmp(magic, kMagic, sizeof kMagic) != 0))
+    r.Fail("not a stokesrods checkpoint");
+  const auto version = r.Get<std::uint32_t>();
+  if (version != kVersion)
+    r.Fail(fmt::format("format version {}, this stokesrods reads version {}", version, kVersion));
+  std::uint64_t stored_sum = 0;
+  if (text.size() < sizeof stored_sum + r.at()) r.Fail("truncated");
+  std::memcpy(&stored_sum, text.data() + text.size() - sizeof stored_sum, sizeof stored_sum);
+  if (stored_sum != Fnv1a(text.data(), text.size() - sizeof stored_sum))
+    r.Fail("damaged (its checksum does not match its contents)");
+  if (r.Get<std::uint64_t>() != ModelFingerprint(model))
+    r.Fail("it belongs to another model (rods, nodes, rest shapes or materials differ)");
+  Checkpoint c;
+  c.time_step = r.Get<double>();
+  c.state.time = r.Get<double>();
+  c.state.step = static_cast<long>(r.Get<std::int64_t>());
+  c.state.q = r.Vector(model.num_dofs, "q");
+  c.state.velocity = r.Vector(model.num_dofs, "the velocity");
+  for (const RodModel& rod : model.rods) {
+    RodFrames f;
+    f.frames.resize(static_cast<std::size_t>(rod.num_nodes() - 1));
+    f.tangents.resize(f.frames.size());
+    for (std::size_t j = 0; j < f.frames.size(); ++j) {
+      r.Raw(f.frames[j].d1.data(), 3 * sizeof(double));
+      r.Raw(f.frames[j].d2.data(), 3 * sizeof(double));
+      r.Raw(f.tangents[j].data(), 3 * sizeof(double));
+    }
+    f.reference_twist = r.Vector(rod.num_nodes(), "a reference twist");
+    c.state.rods.push_back(std::move(f));
+  }
+  c.history.previous_q = r.Vector(model.num_dofs, "the previous q", true);
+  c.history.previous_velocity = r.Vector(model.num_dofs, "the previous velocity", true);
+  c.history.previous_h = r.Get<double>();
+  c.history.hydro_force = r.Vector(3 * model.num_nodes, "the drag", true);
+  c.counters.newton_iterations = static_cast<long>(r.Get<std::int64_t>());
+  c.counters.max_penetration = r.Get<double>();
+  if (r.at() + sizeof stored_sum != text.size()) r.Fail("unexpected data after the contents");
+  return c;
+}
+
+}  // namespace stokesrods
