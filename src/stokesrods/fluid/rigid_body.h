@@ -1,0 +1,35 @@
+// Rigid bodies in the fluid, as more sources of flow beside the rods (issue 11's cell bodies).
+//
+// A body's surface carries N regularized point Stokeslets (the method of regularized Stokeslets,
+// Cortez, Fauci & Medovikov 2005, Phys. Fluids 17:031504) with the blob of stokeslet_segment.h:
+//     8πμ u(x) = Σ_j S_ε(x − x_j) F_j,   F_j the force the surface point j exerts on the fluid [N].
+// A rigid motion (U, Ω) about the centre c prescribes u(x_i) = U + Ω × (x_i − c) at the points;
+// solving 𝕄 F = u for the six unit motions gives the body's 6 × 6 resistance matrix
+//     (F, T) = 𝓡 (U, Ω),   F = Σ F_j,   T = Σ (x_j − c) × F_j   (on the fluid; on the body −).
+// The blob size is a fixed fraction of the point spacing d = √(area/N), so the surface converges
+// as N grows (tests/fluid/rigid_body_test.cc: sphere 6πμaU and 8πμa³Ω, prolate spheroid).
+#pragma once
+
+#include "stokesrods/common/types.h"
+
+namespace stokesrods {
+
+/// Points of a body's surface with their blob size.
+struct BodySurface {
+  Matrix3X points;             ///< on the surface (3 × N) [m]
+  double regularization = 0;   ///< ε [m]
+};
+
+/// N ≥ 2 nearly uniform points on the unit sphere (Fibonacci lattice), deterministic.
+Matrix3X FibonacciSphere(int n);
+
+/// A sphere of `radius` [m] about `center` with N points and ε = blob_over_spacing · √(4πa²/N).
+BodySurface SphereSurface(const Vec3& center, double radius, int n, double blob_over_spacing);
+
+/// 𝕄 (3N × 3N) of the points: U = 𝕄 F with the regularized Stokeslets above [m/(N·s)].
+MatX PointStokesletMobility(const BodySurface& surface, double viscosity);
+
+/// The resistance 𝓡 (6 × 6) of the rigid surface about `center`: (F, T) on the fluid from (U, Ω).
+Mat6 RigidResistance(const BodySurface& surface, const Vec3& center, double viscosity);
+
+}  // namespace stokesrods
