@@ -5,6 +5,7 @@
 #include <Eigen/LU>
 
 #include "stokesrods/common/assert.h"
+#include "stokesrods/fluid/rss.h"
 #include "stokesrods/fluid/stokeslet_segment.h"
 
 namespace stokesrods {
@@ -63,6 +64,91 @@ Mat6 RigidResistance(const BodySurface& surface, const Vec3& center, double visc
       resistance.block<3, 1>(3, mode) += (surface.points.col(i) - center).cross(f);
     }
   return resistance;
+}
+
+MatX AssembleMobilityWithBodies(const FluidParams& params, const std::vector<HydroRod>& rods,
+                                const std::vector<BodySurface>& bodies) {
+  SR_ASSERT(params.model == FluidModel::kRss, "bodies need the RSS fluid model");
+  const Eigen::Index rod_nodes = rods.empty() ? 0 : TotalNodes(rods);
+  Eigen::Index total = rod_nodes;
+  for (const BodySurface& b : bodies) total += b.points.cols();
+  MatX m = MatX::Zero(3 * total, 3 * total);
+  if (!rods.empty()) {
+    MatX rod_block;
+    AssembleRssMobility(params, rods, &rod_block);
+    m.topLeftCorner(3 * rod_nodes, 3 * rod_nodes) = rod_block;
+  }
+  const double scale = 1.0 / (8.0 * kPi * params.viscosity);
+  // All body points in one list, each with its blob.
+  Matrix3X points(3, total - rod_nodes);
+  VecX eps(total - rod_nodes);
+  Eigen::Index k = 0;
+  for (const BodySurface& b : bodies) {
+    points.middleCols(k, b.points.cols()) = b.points;
+    eps.segment(k, b.points.cols()).setConstant(b.regularization);
+    k += b.points.cols();
+  }
+  // Rod nodes in one list.
+  Matrix3X nodes(3, rod_nodes);
+  k = 0;
+  for (const HydroRod& rod : rods) {
+    nodes.middleCols(k, rod.x->cols()) = *rod.x;
+    k += rod.x->cols();
+  }
+  // Body blobs at rod nodes and at body points.
+  for (Eigen::Index j = 0; j < points.cols(); ++j) {
+    const Eigen::Index col = 3 * (rod_nodes + j);
+    for (Eigen::Index i = 0; i < rod_nodes; ++i)
+      m.block<3, 3>(3 * i, col) = scale * RegularizedStokesletMatrix(nodes.col(i) - points.col(j), eps(j));
+    for (Eigen::Index i = 0; i < points.cols(); ++i)
+      m.block<3, 3>(3 * (rod_nodes + i), col) =
+          scale * RegularizedStokesletMatrix(points.col(i) - points.col(j), eps(j));
+  }
+  // Rod segments at body points: A_a f_a + A_b f_b with f = F/Λ (as in rss.cc).
+  Eigen::Index first = 0;
+  for (const HydroRod& rod : rods) {
+    const double rod_eps = params.regularization * rod.radius;
+    const VecX lengths = VoronoiLengths(*rod.x);
+    for (Eigen::Index i = 0; i < points.cols(); ++i)
+      for (Eigen::Index s = 0; s + 1 < rod.x->cols(); ++s) {
+        const SegmentMobility a =
+            StokesletSegment(rod.x->col(s), rod.x->col(s + 1), rod_eps, points.col(i));
+        m.block<3, 3>(3 * (rod_nodes + i), 3 * (first + s)) += scale / lengths(s) * a.a;
+        m.block<3, 3>(3 * (rod_nodes + i), 3 * (first + s + 1)) += scale / lengths(s + 1) * a.b;
+      }
+    first += rod.x->cols();
+  }
+  return m;
+}
+
+Vec6 RigidSwimmerVelocity(const FluidParams& params, const std::vector<HydroRod>& rods,
+                          const BodySurface& body, const Vec3& center, const Vec3& motor_axis,
+                          const Vec3& motor_point, double omega) {
+  const MatX m = AssembleMobilityWithBodies(params, rods, {body});
+  const Eigen::Index n = m.rows() / 3, rod_nodes = n - body.points.cols();
+  Matrix3X x(3, n);  // every point: rod nodes, then the body's
+  Eigen::Index k = 0;
+  for (const HydroRod& rod : rods) {
+    x.middleCols(k, rod.x->cols()) = *rod.x;
+    k += rod.x->cols();
+  }
+  x.rightCols(body.points.cols()) = body.points;
+  MatX g(3 * n, 6);  // rigid motions about the centre
+  VecX w = VecX::Zero(3 * n);  // the motor's relative motion of the rods
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Vec3 r = x.col(i) - center;
+    for (int c = 0; c < 3; ++c) {
+      g.block<3, 1>(3 * i, c) = Vec3::Unit(c);
+      g.block<3, 1>(3 * i, 3 + c) = Vec3::Unit(c).cross(r);
+    }
+    if (i < rod_nodes) w.segment<3>(3 * i) = motor_axis.cross(x.col(i) - motor_point);
+  }
+  const Eigen::PartialPivLU<MatX> lu(m);
+  const MatX mg = lu.solve(g);    // 𝕄⁻¹ G
+  const VecX mw = lu.solve(w);    // 𝕄⁻¹ w
+  const Mat6 resistance = g.transpose() * mg;
+  const Vec6 drive = g.transpose() * mw;
+  return -resistance.partialPivLu().solve(omega * drive);
 }
 
 }  // namespace stokesrods

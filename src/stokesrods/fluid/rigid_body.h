@@ -10,7 +10,10 @@
 // as N grows (tests/fluid/rigid_body_test.cc: sphere 6πμaU and 8πμa³Ω, prolate spheroid).
 #pragma once
 
+#include <vector>
+
 #include "stokesrods/common/types.h"
+#include "stokesrods/fluid/hydrodynamics.h"
 
 namespace stokesrods {
 
@@ -31,5 +34,21 @@ MatX PointStokesletMobility(const BodySurface& surface, double viscosity);
 
 /// The resistance 𝓡 (6 × 6) of the rigid surface about `center`: (F, T) on the fluid from (U, Ω).
 Mat6 RigidResistance(const BodySurface& surface, const Vec3& center, double viscosity);
+
+/// 𝕄 over the rods' nodes (RSS, as AssembleMobility) followed by the bodies' points, with every
+/// coupling: rod segments at body points (eq. 8 with the rods' Voronoi lengths), body blobs at rod
+/// nodes and at each other's points (each blob with its own ε) [m/(N·s)]. RSS only.
+MatX AssembleMobilityWithBodies(const FluidParams& params, const std::vector<HydroRod>& rods,
+                                const std::vector<BodySurface>& bodies);
+
+/// A rigid swimmer: one body and rigid rods fixed to it, the rods turned by a motor at rate ω
+/// [rad/s] about `motor_axis` (unit) through `motor_point`, relative to the body; no external
+/// force or torque. Its body moves with (U, Ω) about `center`, the rods with U + Ω × (x − c)
+/// + ω a × (x − x_m). Force- and torque-free: Gᵀ 𝕄⁻¹ (G (U, Ω) + ω w) = 0, G the rigid motions at
+/// all points and w the motor's. Returns (U, Ω) (6) [m/s, rad/s]. The reference calculation for
+/// the free-swimming cell of issue 11.
+Vec6 RigidSwimmerVelocity(const FluidParams& params, const std::vector<HydroRod>& rods,
+                          const BodySurface& body, const Vec3& center, const Vec3& motor_axis,
+                          const Vec3& motor_point, double omega);
 
 }  // namespace stokesrods
