@@ -30,7 +30,7 @@ BodySurface SphereSurface(const Vec3& center, double radius, int n, double blob_
   return s;
 }
 
-MatX PointStokesletMobility(const BodySurface& surface, double viscosity) {
+MatX PointStokesletMobility(const BodySurface& surface, double viscosity, const Wall* wall) {
   SR_ASSERT(viscosity > 0.0 && surface.regularization > 0.0, "mobility needs μ > 0 and ε > 0");
   const Eigen::Index n = surface.points.cols();
   MatX m(3 * n, 3 * n);
@@ -39,14 +39,17 @@ MatX PointStokesletMobility(const BodySurface& surface, double viscosity) {
   for (Eigen::Index j = 0; j < n; ++j)
     for (Eigen::Index i = 0; i < n; ++i)
       m.block<3, 3>(3 * i, 3 * j) =
-          scale * RegularizedStokesletMatrix(surface.points.col(i) - surface.points.col(j),
-                                             surface.regularization);
+          scale * (wall ? RegularizedBlakeletMatrix(*wall, surface.points.col(i),
+                                                    surface.points.col(j), surface.regularization)
+                        : RegularizedStokesletMatrix(surface.points.col(i) - surface.points.col(j),
+                                                     surface.regularization));
   return m;
 }
 
-Mat6 RigidResistance(const BodySurface& surface, const Vec3& center, double viscosity) {
+Mat6 RigidResistance(const BodySurface& surface, const Vec3& center, double viscosity,
+                     const Wall* wall) {
   const Eigen::Index n = surface.points.cols();
-  const Eigen::PartialPivLU<MatX> lu(PointStokesletMobility(surface, viscosity));
+  const Eigen::PartialPivLU<MatX> lu(PointStokesletMobility(surface, viscosity, wall));
   MatX velocities(3 * n, 6);  // the six unit rigid motions at the points
   for (Eigen::Index i = 0; i < n; ++i) {
     const Vec3 r = surface.points.col(i) - center;

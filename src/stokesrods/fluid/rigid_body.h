@@ -14,6 +14,7 @@
 
 #include "stokesrods/common/types.h"
 #include "stokesrods/fluid/hydrodynamics.h"
+#include "stokesrods/fluid/wall.h"
 
 namespace stokesrods {
 
@@ -29,11 +30,15 @@ Matrix3X FibonacciSphere(int n);
 /// A sphere of `radius` [m] about `center` with N points and ε = blob_over_spacing · √(4πa²/N).
 BodySurface SphereSurface(const Vec3& center, double radius, int n, double blob_over_spacing);
 
-/// 𝕄 (3N × 3N) of the points: U = 𝕄 F with the regularized Stokeslets above [m/(N·s)].
-MatX PointStokesletMobility(const BodySurface& surface, double viscosity);
+/// 𝕄 (3N × 3N) of the points: U = 𝕄 F with the regularized Stokeslets above [m/(N·s)]; with a
+/// `wall`, the Stokeslets and their images (wall.h).
+MatX PointStokesletMobility(const BodySurface& surface, double viscosity,
+                            const Wall* wall = nullptr);
 
-/// The resistance 𝓡 (6 × 6) of the rigid surface about `center`: (F, T) on the fluid from (U, Ω).
-Mat6 RigidResistance(const BodySurface& surface, const Vec3& center, double viscosity);
+/// The resistance 𝓡 (6 × 6) of the rigid surface about `center`: (F, T) on the fluid from (U, Ω);
+/// with a `wall`, in the half space above it.
+Mat6 RigidResistance(const BodySurface& surface, const Vec3& center, double viscosity,
+                     const Wall* wall = nullptr);
 
 /// 𝕄 over the rods' nodes (RSS, as AssembleMobility) followed by the bodies' points, with every
 /// coupling: rod segments at body points (eq. 8 with the rods' Voronoi lengths), body blobs at rod

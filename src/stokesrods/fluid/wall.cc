@@ -1,0 +1,34 @@
+#include "stokesrods/fluid/wall.h"
+
+#include <cmath>
+
+#include "stokesrods/common/assert.h"
+#include "stokesrods/fluid/stokeslet_segment.h"
+
+namespace stokesrods {
+
+Mat3 RegularizedBlakeletMatrix(const Wall& wall, const Vec3& x, const Vec3& x0,
+                               double regularization) {
+  const Vec3& n = wall.normal;
+  const double h = (x0 - wall.point).dot(n);
+  SR_DASSERT(h > 0.0, "a blob on or behind the wall");
+  const double eps2 = regularization * regularization;
+  const Vec3 r = x - x0;
+  const Vec3 big_r = r + 2.0 * h * n;  // x − x0*
+  const Mat3 reflect = Mat3::Identity() - 2.0 * n * n.transpose();
+  const Vec3 reflected = reflect * big_r;  // Δ R
+  const double r2 = big_r.squaredNorm(), r_n = big_r.dot(n);
+  const double inv = 1.0 / std::sqrt(r2 + eps2);
+  const double inv3 = inv * inv * inv, inv5 = inv3 * inv * inv;
+  Mat3 w = RegularizedStokesletMatrix(r, regularization) -
+           RegularizedStokesletMatrix(big_r, regularization);
+  w += 2.0 * h * h * (reflect * inv3 - 3.0 * inv5 * big_r * reflected.transpose()) -
+       6.0 * h * h * eps2 * inv5 * reflect;
+  w += 2.0 * h *
+       ((r2 + 4.0 * eps2) * inv5 * n * reflected.transpose() - r_n * inv3 * reflect +
+        inv3 * big_r * n.transpose() + 3.0 * r_n * inv5 * big_r * reflected.transpose());
+  w += 6.0 * h * eps2 * inv5 * (r_n * Mat3::Identity() - n * big_r.transpose());
+  return w;
+}
+
+}  // namespace stokesrods

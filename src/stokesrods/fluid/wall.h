@@ -1,0 +1,33 @@
+// A plane no-slip wall: the regularized Stokeslet and its image system (issue 11).
+//
+// Wall through `point` with unit normal n into the fluid; a blob of size ε at x0, height
+// h = (x0 − p)·n > 0, force f; its image point x0* = x0 − 2h n; r = x − x0, R = x − x0*,
+// Δ = I − 2 n nᵀ, R_ε² = |R|² + ε², S_ε of stokeslet_segment.h. Then 8πμ u(x) = W f with
+//   W = S_ε(r) − S_ε(R)                                                   (Stokeslet and image)
+//     + 2h² (Δ/R_ε³ − 3 R (ΔR)ᵀ/R_ε⁵) − 6h²ε² Δ/R_ε⁵                     (potential dipole, blob)
+//     + 2h [n (ΔR)ᵀ (|R|² + 4ε²)/R_ε⁵ − Δ (R·n)/R_ε³ + R nᵀ/R_ε³
+//           + 3 R (ΔR)ᵀ (R·n)/R_ε⁵]                                       (Stokes doublet)
+//     + 6hε² ((R·n) I − n Rᵀ)/R_ε⁵                                        (rotlet)
+// The structure is that of Ainley, Durkin, Embid, Boindala & Cortez (J Comput Phys 227:4600,
+// 2008; Smith, Proc R Soc A 465:3605, 2009 corrects a sign); we did not have the paper's final
+// formula and derived the last (rotlet) term ourselves by requiring W = 0 on the wall for every ε.
+// Checked (tests/fluid/wall_test.cc): W = 0 on the wall to round-off for all ε, h and
+// orientations; ∇·u = 0 (finite differences); ε → 0 gives Blake's (1971) singular image system,
+// coded independently from its potentials; a sphere's drag parallel and normal to the wall against
+// Faxén's and Brenner's (1961) results.
+#pragma once
+
+#include "stokesrods/common/types.h"
+
+namespace stokesrods {
+
+struct Wall {
+  Vec3 point = Vec3::Zero();     ///< a point of the wall [m]
+  Vec3 normal = Vec3::UnitZ();   ///< unit normal, pointing into the fluid
+};
+
+/// W above (8πμ times the mobility of a point force) [1/m]. Precondition: x0 above the wall.
+Mat3 RegularizedBlakeletMatrix(const Wall& wall, const Vec3& x, const Vec3& x0,
+                               double regularization);
+
+}  // namespace stokesrods
