@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <algorithm>
 #include <cstdio>
 #include <random>
 
@@ -134,6 +135,65 @@ double FaxenParallel(double h_over_a) {
   const double s = 1.0 / h_over_a;
   return 1.0 / (1.0 - 9.0 / 16.0 * s + std::pow(s, 3) / 8.0 - 45.0 / 256.0 * std::pow(s, 4) -
                 std::pow(s, 5) / 16.0);
+}
+
+// L ∫ φ(α) W(x̂, x_α) dα by adaptive bisection of 10-point Gauss panels (against two halves),
+// split at the projection of x̂: the whole kernel at once, as a reference for the split into the
+// free closed form and the Gauss-integrated images.
+using Pair = Eigen::Matrix<double, 3, 6>;
+Pair GaussPanel(const Wall& w, const Vec3& xa, const Vec3& v, double eps, const Vec3& x, double a,
+                double b) {
+  const double* nodes = nullptr;
+  const double* weights = nullptr;
+  GaussLegendreRule01(10, &nodes, &weights);
+  Pair sum = Pair::Zero();
+  for (int q = 0; q < 10; ++q) {
+    const double alpha = a + (b - a) * nodes[q];
+    const Mat3 k = (b - a) * weights[q] * v.norm() * RegularizedBlakeletMatrix(w, x, xa + alpha * v, eps);
+    sum.leftCols<3>() += (1.0 - alpha) * k;
+    sum.rightCols<3>() += alpha * k;
+  }
+  return sum;
+}
+Pair Adaptive(const Wall& w, const Vec3& xa, const Vec3& v, double eps, const Vec3& x, double a,
+              double b, double tolerance, int depth = 0) {
+  const double m = 0.5 * (a + b);
+  const Pair whole = GaussPanel(w, xa, v, eps, x, a, b);
+  const Pair halves = GaussPanel(w, xa, v, eps, x, a, m) + GaussPanel(w, xa, v, eps, x, m, b);
+  if ((whole - halves).norm() < tolerance || depth > 40) return halves;
+  return Adaptive(w, xa, v, eps, x, a, m, tolerance, depth + 1) +
+         Adaptive(w, xa, v, eps, x, m, b, tolerance, depth + 1);
+}
+
+TEST(Wall, SegmentsNearTheWallMatchAdaptiveQuadratureOfTheWholeKernel) {
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const Wall w = TiltedWall();
+  const double length = 0.05, eps = 0.01;
+  double worst = 0.0;
+  for (int k = 0; k < 100; ++k) {
+    // Segments from touching distance (height ε) to far; targets at their end points, near them
+    // and anywhere above the wall.
+    const double height = eps * std::pow(10.0, 1.5 * (u(rng) + 1.0));
+    const Vec3 xa = AtHeight(w, u(rng), u(rng), height);
+    const Vec3 xb = xa + length * Vec3(u(rng), u(rng), 0.3 * u(rng)).normalized();
+    if ((xb - w.point).dot(w.normal) <= 0.5 * eps) continue;
+    const Vec3 x = k % 3 == 0 ? xb
+                 : k % 3 == 1 ? Vec3(0.5 * (xa + xb) + 0.02 * Vec3(u(rng), u(rng), u(rng)))
+                              : AtHeight(w, 0.3 * u(rng), 0.3 * u(rng), 0.5 * (u(rng) + 1.0) + 1e-3);
+    const SegmentMobility s = StokesletSegmentNearWall(w, xa, xb, eps, x);
+    Pair ours;
+    ours << s.a, s.b;
+    const Vec3 v = xb - xa;
+    const double star = std::clamp((x - xa).dot(v) / v.squaredNorm(), 0.0, 1.0);
+    const double scale = ours.norm();
+    Pair reference = Pair::Zero();
+    if (star > 0.0) reference += Adaptive(w, xa, v, eps, x, 0.0, star, 1e-13 * scale);
+    if (star < 1.0) reference += Adaptive(w, xa, v, eps, x, star, 1.0, 1e-13 * scale);
+    worst = std::max(worst, (ours - reference).norm() / reference.norm());
+  }
+  EXPECT_LT(worst, 1e-10);
+  std::printf("segments near the wall: worst relative difference %.3e\n", worst);
 }
 
 // The sphere's drag near the wall relative to its free drag, with the same points (so the

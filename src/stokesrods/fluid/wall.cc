@@ -1,5 +1,6 @@
 #include "stokesrods/fluid/wall.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "stokesrods/common/assert.h"
@@ -29,6 +30,32 @@ Mat3 RegularizedBlakeletMatrix(const Wall& wall, const Vec3& x, const Vec3& x0,
         inv3 * big_r * n.transpose() + 3.0 * r_n * inv5 * big_r * reflected.transpose());
   w += 6.0 * h * eps2 * inv5 * (r_n * Mat3::Identity() - n * big_r.transpose());
   return w;
+}
+
+SegmentMobility StokesletSegmentNearWall(const Wall& wall, const Vec3& xa, const Vec3& xb,
+                                         double regularization, const Vec3& point) {
+  SegmentMobility out = StokesletSegment(xa, xb, regularization, point);
+  const Vec3 v = xb - xa;
+  const double length = v.norm();
+  // The mirrored segment and the target's distance to it.
+  auto mirror = [&](const Vec3& y) { return Vec3(y - 2.0 * (y - wall.point).dot(wall.normal) * wall.normal); };
+  const Vec3 ma = mirror(xa), mv = mirror(xb) - ma;
+  const double t = std::clamp((point - ma).dot(mv) / mv.squaredNorm(), 0.0, 1.0);
+  const double distance = std::hypot((point - ma - t * mv).norm(), regularization);
+  const int panels = std::max(1, static_cast<int>(std::ceil(length / distance)));
+  const double* nodes = nullptr;
+  const double* weights = nullptr;
+  GaussLegendreRule01(20, &nodes, &weights);
+  for (int p = 0; p < panels; ++p)
+    for (int q = 0; q < 20; ++q) {
+      const double alpha = (p + nodes[q]) / panels, w = weights[q] * length / panels;
+      const Vec3 y = xa + alpha * v;
+      const Mat3 image = RegularizedBlakeletMatrix(wall, point, y, regularization) -
+                         RegularizedStokesletMatrix(point - y, regularization);
+      out.a += w * (1.0 - alpha) * image;
+      out.b += w * alpha * image;
+    }
+  return out;
 }
 
 }  // namespace stokesrods

@@ -18,6 +18,7 @@
 #pragma once
 
 #include "stokesrods/common/types.h"
+#include "stokesrods/fluid/stokeslet_segment.h"
 
 namespace stokesrods {
 
@@ -29,5 +30,13 @@ struct Wall {
 /// W above (8πμ times the mobility of a point force) [1/m]. Precondition: x0 above the wall.
 Mat3 RegularizedBlakeletMatrix(const Wall& wall, const Vec3& x, const Vec3& x0,
                                double regularization);
+
+/// A_a, A_b of a Regularized Stokeslet Segment (as StokesletSegment) above the wall: the free
+/// part by its closed forms, the images' part L ∫ φ(α) (W − S_ε)(x̂, x_α) dα by 20-point
+/// Gauss–Legendre on panels no longer than the distance from x̂ to the mirrored segment (that
+/// part's nearest singularity), which is exact to rounding there (stokeslet_segment.cc).
+/// Precondition: the segment and x̂ above the wall.
+SegmentMobility StokesletSegmentNearWall(const Wall& wall, const Vec3& xa, const Vec3& xb,
+                                         double regularization, const Vec3& point);
 
 }  // namespace stokesrods
