@@ -124,7 +124,10 @@ void MatrixFreeRssMobility::Update(const std::vector<HydroRod>& rods) {
   if (!far_) {
     far_ = pairs < options_.direct_sum_below
                ? MakeDirectStokesletSum()
-               : MakeFastStokesletSum({.tolerance = options_.tolerance});
+               : MakeFastStokesletSum(
+                     {.tolerance = options_.fast_sum_tolerance,
+                      .direct_below_pairs = static_cast<std::int64_t>(options_.direct_sum_below),
+                      .choose_by_cost = options_.fast_sum_by_cost});
   }
   far_->Build(gauss_points_, gauss_eps_, nodes_);
   FindNearPairs(nodes_);

@@ -33,8 +33,14 @@ struct MobilityOptions {
   /// Matrix-free: bound on the relative error of each far segment–node interaction (quadrature)
   /// and of the fast sum [–].
   double tolerance = 1e-8;
-  /// Matrix-free: the far-field sum runs directly below this many source–target pairs.
+  /// Matrix-free: the far-field sum runs directly below this many source–target pairs; above,
+  /// the FMM (stokeslet_sum.h) decides by its cost model.
   double direct_sum_below = 4e6;
+  /// Matrix-free: the FMM's bound on the error of the far-field sum, relative per node to
+  /// Σ |S||g| over the Gauss points (stokeslet_sum.h); it sets the expansion order (fmm_sum.cc) [–].
+  double fast_sum_tolerance = 1e-5;
+  /// Matrix-free: false uses the FMM whenever the geometry allows it, paying or not (tests).
+  bool fast_sum_by_cost = true;
 };
 
 class MobilityOperator {

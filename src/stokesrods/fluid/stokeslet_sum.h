@@ -25,24 +25,19 @@ struct StokesletSumOptions {
   double tolerance = 1e-6;
   /// The fast sum sums directly when (sources × targets) is below this.
   std::int64_t direct_below_pairs = 1'000'000;
-  /// Most points in a leaf of the source and target cluster trees.
-  int leaf_size = 32;
-  /// A block (target cluster τ, source cluster σ) is approximated at low rank when
-  /// max(diam τ, diam σ) ≤ admissibility · dist(τ, σ) (bounding boxes) [–].
-  double admissibility = 1.0;
-  /// Memory for the low-rank factors; above it Build gives up and the sum is direct [MB].
-  double max_megabytes = 300.0;
-  /// Estimate the memory and the Apply cost of the hierarchical matrix before building it, and
-  /// sum directly when it would not fit or not pay off (false: always build it, for tests).
+  /// Sum directly when the cost model of the tree says it would not pay (false: build the tree
+  /// whenever the points allow one, for tests).
   bool choose_by_cost = true;
+  /// Points per edge of the FMM's surfaces; 0: chosen from the tolerance (fmm_sum.cc).
+  int order = 0;
 };
 
 /// What a Build produced (for tests and benchmarks).
 struct StokesletSumStats {
   std::int64_t near_pairs = 0;  ///< (target, source) pairs summed exactly
-  std::int64_t far_pairs = 0;   ///< (target, source) pairs in low-rank (far-field) blocks
-  std::int64_t stored_values = 0;  ///< doubles stored by Build (low-rank factors, points)
-  int max_rank = 0;                ///< largest rank of a far-field block
+  std::int64_t far_pairs = 0;   ///< (target, source) pairs summed by expansions
+  std::int64_t stored_values = 0;  ///< doubles stored by Build (points, expansions)
+  int max_rank = 0;                ///< rank of the compressed M2L translations
 };
 
 class StokesletSum {
@@ -60,8 +55,8 @@ class StokesletSum {
 /// The direct sum (OpenMP over targets): exact to rounding, O(S T) per Apply.
 std::unique_ptr<StokesletSum> MakeDirectStokesletSum();
 
-/// The fast sum (tree code / fast multipole; see stokeslet_sum.cc for the method and its error
-/// control). Falls back to the direct sum for small problems.
+/// The fast sum (a kernel-independent fast multipole method; see fmm_sum.cc for the method and
+/// its error control). Falls back to the direct sum for small problems and where it does not pay.
 std::unique_ptr<StokesletSum> MakeFastStokesletSum(const StokesletSumOptions& options);
 
 }  // namespace stokesrods

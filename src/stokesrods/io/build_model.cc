@@ -181,6 +181,7 @@ Model BuildModel(const Config& config) {
       config.fluid.solver == "direct" ? HydroSolver::kDirect : HydroSolver::kKrylov;
   model.hydro.krylov_tolerance = config.fluid.krylov_tolerance;
   model.hydro.mobility.tolerance = config.fluid.far_field_tolerance;
+  model.hydro.mobility.fast_sum_tolerance = config.fluid.fast_sum_tolerance;
   model.integrator =
       config.run.integrator == "bdf2" ? TimeIntegrator::kBdf2 : TimeIntegrator::kEuler;
   model.contact = config.contact.enabled;

@@ -39,6 +39,7 @@ void VisitFields(FluidConfig& c, V& v) {
   v("coupling", c.coupling);
   v("mobility", c.mobility);
   v("far_field_tolerance", c.far_field_tolerance);
+  v("fast_sum_tolerance", c.fast_sum_tolerance);
   v("solver", c.solver);
   v("krylov_tolerance", c.krylov_tolerance);
 }

@@ -125,6 +125,9 @@ void ValidateConfig(Config* config) {
   c.Positive("fluid.krylov_tolerance", config->fluid.krylov_tolerance);
   if (config->fluid.far_field_tolerance >= 1e-2)
     throw ConfigError(c.file, "fluid.far_field_tolerance", "must be below 1e-2");
+  c.Positive("fluid.fast_sum_tolerance", config->fluid.fast_sum_tolerance);
+  if (config->fluid.fast_sum_tolerance >= 1e-2)
+    throw ConfigError(c.file, "fluid.fast_sum_tolerance", "must be below 1e-2");
   if (config->fluid.krylov_tolerance >= 1e-2)
     throw ConfigError(c.file, "fluid.krylov_tolerance", "must be below 1e-2");
   c.Positive("contact.tolerance", config->contact.tolerance);

@@ -1,0 +1,93 @@
+#include "stokesrods/fluid/fmm_operators.h"
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <utility>
+
+#include "stokesrods/common/assert.h"
+#include "stokesrods/fluid/stokeslet_segment.h"
+
+namespace stokesrods {
+namespace {
+
+/// The points of the m × m × m grid of [−1, 1]³ on the cube's surface.
+Matrix3X CubeSurface(int m) {
+  std::vector<Vec3> points;
+  const double step = 2.0 / (m - 1);
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < m; ++j)
+      for (int k = 0; k < m; ++k)
+        if (i == 0 || j == 0 || k == 0 || i == m - 1 || j == m - 1 || k == m - 1)
+          points.emplace_back(-1.0 + step * i, -1.0 + step * j, -1.0 + step * k);
+  Matrix3X out(3, static_cast<Eigen::Index>(points.size()));
+  for (std::size_t c = 0; c < points.size(); ++c) out.col(static_cast<Eigen::Index>(c)) = points[c];
+  return out;
+}
+
+/// [S(x_i − y_j)] (3|X| × 3|Y|), singular Stokeslets; X and Y disjoint.
+MatX KernelMatrix(const Matrix3X& x, const Matrix3X& y) {
+  MatX k(3 * x.cols(), 3 * y.cols());
+  for (Eigen::Index j = 0; j < y.cols(); ++j)
+    for (Eigen::Index i = 0; i < x.cols(); ++i)
+      k.block<3, 3>(3 * i, 3 * j) = StokesletMatrix(x.col(i) - y.col(j));
+  return k;
+}
+
+/// The pseudo-inverse, singular values below cutoff · σ_max dropped.
+MatX PseudoInverse(const MatX& a, double cutoff) {
+  Eigen::BDCSVD<MatX> svd(a, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  const VecX& s = svd.singularValues();
+  VecX inv = VecX::Zero(s.size());
+  for (Eigen::Index i = 0; i < s.size(); ++i)
+    if (s[i] > cutoff * s[0]) inv[i] = 1.0 / s[i];
+  return svd.matrixV() * inv.asDiagonal() * svd.matrixU().transpose();
+}
+
+std::unique_ptr<FmmOperators> MakeOperators(int order, double cutoff) {
+  auto op = std::make_unique<FmmOperators>();
+  op->order = order;
+  op->cutoff = cutoff;
+  op->surface = CubeSurface(order);
+  op->points = static_cast<int>(op->surface.cols());
+  const Matrix3X inner = kFmmInnerRadius * op->surface, outer = kFmmOuterRadius * op->surface;
+  op->check_to_up = PseudoInverse(KernelMatrix(outer, inner), cutoff);
+  op->check_to_down = PseudoInverse(KernelMatrix(inner, outer), cutoff);
+  for (int c = 0; c < 8; ++c) {
+    // Child c's centre in the parent's units (bit 2: +x, bit 1: +y, bit 0: +z).
+    const Vec3 o(c & 4 ? 0.25 : -0.25, c & 2 ? 0.25 : -0.25, c & 1 ? 0.25 : -0.25);
+    const Matrix3X child_inner = (0.5 * inner).colwise() + o;
+    op->m2m[static_cast<size_t>(c)] = op->check_to_up * KernelMatrix(outer, child_inner);
+    const Matrix3X parent_outer = (2.0 * outer).colwise() - 2.0 * o;  // in the child's units
+    op->l2l[static_cast<size_t>(c)] = op->check_to_down * KernelMatrix(inner, parent_outer);
+  }
+  std::vector<std::array<int, 3>> offsets;
+  for (int x = -3; x <= 3; ++x)
+    for (int y = -3; y <= 3; ++y)
+      for (int z = -3; z <= 3; ++z)
+        if (std::max({std::abs(x), std::abs(y), std::abs(z)}) >= 2 && M2lIndex(x, y, z) > 171)
+          offsets.push_back({x, y, z});
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::size_t i = 0; i < offsets.size(); ++i) {
+    const auto [x, y, z] = offsets[i];
+    const Matrix3X source = inner.colwise() + Vec3(x, y, z);  // the box at offset v = source − target
+    op->m2l[static_cast<size_t>(M2lIndex(x, y, z))] = KernelMatrix(inner, source);
+  }
+  return op;
+}
+
+}  // namespace
+
+const FmmOperators& GetFmmOperators(int order, double cutoff) {
+  SR_ASSERT(order >= 2 && order <= 12, "FMM order out of range");
+  static std::mutex mutex;
+  static std::map<std::pair<int, double>, std::unique_ptr<FmmOperators>> cache;
+  const std::lock_guard<std::mutex> lock(mutex);
+  auto& entry = cache[{order, cutoff}];
+  if (!entry) entry = MakeOperators(order, cutoff);
+  return *entry;
+}
+
+}  // namespace stokesrods

@@ -1,0 +1,306 @@
+// The fast Stokeslet sum: a kernel-independent FMM (Ying, Biros & Zorin 2004) on a uniform-depth
+// octree (fmm_tree.h) with precomputed, width-independent translation operators (fmm_operators.h).
+//
+// Apply: S2M (the leaf's sources, with their own regularized kernel, evaluated on the upward check
+// surface and fitted by upward equivalent densities), M2M up to level 2, M2L (compressed, k × k) over
+// the V lists of every level, L2L down, L2T (the downward equivalent densities evaluated at the
+// targets), and the near field (the 27 neighbouring leaves) summed directly with the regularized
+// kernel by the vectorized loop of the direct sum. Every box's work is done by one thread, in a
+// fixed order: Apply is deterministic.
+//
+// REGULARIZATION. Far (V-list) pairs are approximated by Stokes flows, while S_ε is one only up
+// to O((ε/r)⁴): S_ε = S + (ε²/2)(I − 3 r̂r̂ᵀ)/r³ + ε⁴(−9/8 I + 15/8 r̂r̂ᵀ)/r⁵ + …, whose ε² term
+// (a potential dipole) is a Stokes flow the equivalent densities reproduce (S2M uses S_ε itself)
+// and whose ε⁴ term is not. Far pairs are at least a leaf width w apart, so leaves are kept no
+// narrower than w_min = ε_max (c_ε / tolerance)^(1/4), which bounds that part of the error by
+// the tolerance (c_ε below, measured).
+#include <algorithm>
+#include <array>
+#include <utility>
+#include <vector>
+#include <cmath>
+#include <memory>
+
+#include "stokesrods/common/assert.h"
+#include "stokesrods/fluid/fmm_operators.h"
+#include "stokesrods/fluid/fmm_tree.h"
+#include "stokesrods/fluid/point_stokeslet.h"
+#include "stokesrods/fluid/stokeslet_sum.h"
+
+namespace stokesrods {
+namespace {
+
+constexpr double kEpsilonConstant = 2.0;  // c_ε
+
+extern "C" void dgemm_(const char* transa, const char* transb, const int* m, const int* n,
+                       const int* k, const double* alpha, const double* a, const int* lda,
+                       const double* b, const int* ldb, const double* beta, double* c,
+                       const int* ldc);
+
+/// c = alpha op(a) b + beta c by the BLAS (OpenBLAS: its kernels for the CPU at hand, and its
+/// threads; the build itself targets baseline x86-64, where Eigen's products are 5–10× slower).
+void Gemm(const MatX& a, bool transpose_a, const MatX& b, double alpha, double beta, MatX* c) {
+  const int m = static_cast<int>(transpose_a ? a.cols() : a.rows());
+  const int n = static_cast<int>(b.cols()), k = static_cast<int>(b.rows());
+  if (beta == 0.0) c->resize(m, n);
+  if (m == 0 || n == 0) return;
+  const int lda = static_cast<int>(a.rows()), ldb = k, ldc = m;
+  const char ta = transpose_a ? 'T' : 'N', tb = 'N';
+  dgemm_(&ta, &tb, &m, &n, &k, &alpha, a.data(), &lda, b.data(), &ldb, &beta, c->data(), &ldc);
+}
+
+
+class FmmStokesletSum final : public StokesletSum {
+ public:
+  explicit FmmStokesletSum(const StokesletSumOptions& options)
+      : options_(options), direct_(MakeDirectStokesletSum()) {
+    SR_ASSERT(options.tolerance > 0.0 && options.tolerance < 1.0, "tolerance in (0, 1)");
+  }
+
+  void Build(const Matrix3X& sources, const VecX& regularization,
+             const Matrix3X& targets) override;
+  void Apply(const Matrix3X& strengths, Matrix3X* w) const override;
+  StokesletSumStats Stats() const override { return stats_; }
+
+ private:
+  void Upward() const;
+  void Downward() const;
+  void Leaves(Matrix3X* w) const;
+  void M2l(int level) const;
+  void GroupM2l();
+
+  StokesletSumOptions options_;
+  std::unique_ptr<StokesletSum> direct_;
+  bool use_direct_ = true;
+  const FmmOperators* op_ = nullptr;
+  FmmTree tree_;
+  Matrix3X x_;        // targets in tree order
+  mutable MatX src_;  // S × 7 sources in tree order (point_stokeslet.h), current strengths
+  // M2L pairs (target box, source box) per level and offset, in the order of the target boxes, and
+  // their products' scratch.
+  std::vector<std::array<std::vector<std::pair<int, int>>, 343>> m2l_pairs_;
+  mutable MatX m2l_in_, m2l_out_;
+  mutable std::vector<MatX> up_, check_, down_;  // per level: 3n × boxes
+  StokesletSumStats stats_;
+};
+
+// ORDER. Measured error (the header's norm; tests/fluid/stokeslet_sum_test.cc) with p points per
+// edge, the worst of random clouds (6 000 × 3 000 and 20 000 × 5 000 points in a cube) and helix
+// lattices (20 and 100 helices), pseudo-inverses cut at 1e-6 σ_max (smaller cutoffs were worse,
+// 1e-9 gave 1e-4 at p = 5: the fits amplify rounding):
+//     p            4        5        6
+//     3n           168      294      456      (n = p³ − (p−2)³ points per surface)
+//     error        6.4e-5   1.4e-5   8.1e-7
+// We take the smallest p whose error × 1.5 is within the tolerance: p = 4 from 1e-4, 5 from 2e-5,
+// 6 from 1.25e-6; below that no order (p = 7 would store 0.5 GB of K_v) and the sum is direct.
+// These are errors of many sources, where the exact near field dominates Σ|S||g|; one source
+// alone against targets just past its neighbour boxes (one box width away) is approximated far
+// worse, like any FMM on 1-separated boxes: worst of 20 placements 2e-2, 4e-2, 1.8e-4 relative
+// at p = 4, 5, 6.
+constexpr double kCutoff = 1e-6;
+constexpr std::array<double, 3> kOrderError = {6.4e-5, 1.4e-5, 8.1e-7};  // p = 4, 5, 6
+
+/// p for the options; 0 when no order reaches the tolerance.
+int OrderFor(const StokesletSumOptions& options) {
+  if (options.order > 0) return options.order;
+  for (int p = 4; p <= 6; ++p)
+    if (1.5 * kOrderError[static_cast<size_t>(p - 4)] <= options.tolerance) return p;
+  return 0;
+}
+
+void FmmStokesletSum::Build(const Matrix3X& sources, const VecX& regularization,
+                            const Matrix3X& targets) {
+  SR_ASSERT(regularization.size() == sources.cols(), "one ε per source");
+  const double pairs = static_cast<double>(sources.cols()) * static_cast<double>(targets.cols());
+  use_direct_ = true;
+  tree_ = FmmTree{};
+  const int order = OrderFor(options_);
+  if (order > 0 && pairs >= static_cast<double>(options_.direct_below_pairs)) {
+    const double n = order * order * order - (order - 2) * (order - 2) * (order - 2);
+    // Costs in kernel evaluations (≈ 1.7 ns): a matrix entry ≈ 0.05 in the batched products
+    // (≈ 20 GFlop/s), and ≈ 0.6 to read and pack one K_v entry per level (memory bound).
+    const double entries = 9.0 * n * n;
+    const FmmCost cost{.per_point = n,
+                       .per_box = 0.05 * 4.0 * entries,
+                       .per_m2l = 0.05 * entries,
+                       .per_offset = 0.6 * entries};
+    const double eps_max = regularization.size() > 0 ? regularization.cwiseAbs().maxCoeff() : 0.0;
+    const double min_width = eps_max * std::pow(kEpsilonConstant / options_.tolerance, 0.25);
+    tree_ = BuildFmmTree(sources, targets, min_width, cost, !options_.choose_by_cost);
+    use_direct_ = tree_.depth == 0;
+    if (!use_direct_) op_ = &GetFmmOperators(order, kCutoff);
+  }
+  stats_ = StokesletSumStats{};
+  if (use_direct_) {
+    direct_->Build(sources, regularization, targets);
+    stats_ = direct_->Stats();
+    return;
+  }
+  const auto ns = static_cast<Eigen::Index>(sources.cols());
+  src_.resize(ns, 7);
+  for (Eigen::Index s = 0; s < ns; ++s) {
+    const int k = tree_.source_order[static_cast<size_t>(s)];
+    src_.row(s).head<3>() = sources.col(k).transpose();
+    src_(s, 3) = regularization[k] * regularization[k];
+  }
+  x_.resize(3, targets.cols());
+  for (Eigen::Index t = 0; t < targets.cols(); ++t)
+    x_.col(t) = targets.col(tree_.target_order[static_cast<size_t>(t)]);
+  const int levels = tree_.depth + 1;
+  up_.assign(static_cast<size_t>(levels), MatX());
+  check_.assign(static_cast<size_t>(levels), MatX());
+  down_.assign(static_cast<size_t>(levels), MatX());
+  stats_.near_pairs = tree_.near_pairs;
+  stats_.far_pairs = static_cast<std::int64_t>(pairs) - tree_.near_pairs;
+  stats_.max_rank = 3 * op_->points;
+  stats_.stored_values = src_.size() + x_.size();
+  for (int l = 2; l < levels; ++l) {
+    const auto boxes = static_cast<Eigen::Index>(tree_.levels[static_cast<size_t>(l)].size());
+    up_[static_cast<size_t>(l)].resize(3 * op_->points, boxes);
+    check_[static_cast<size_t>(l)].resize(3 * op_->points, boxes);
+    down_[static_cast<size_t>(l)].resize(3 * op_->points, boxes);
+    stats_.stored_values += 9 * op_->points * boxes;
+  }
+  GroupM2l();
+}
+
+void FmmStokesletSum::GroupM2l() {
+  m2l_pairs_.assign(static_cast<size_t>(tree_.depth) + 1, {});
+  for (int l = 2; l <= tree_.depth; ++l) {
+    const FmmList& v = tree_.v_lists[static_cast<size_t>(l)];
+    const int boxes = static_cast<int>(tree_.levels[static_cast<size_t>(l)].size());
+    auto& pairs = m2l_pairs_[static_cast<size_t>(l)];
+    for (int b = 0; b < boxes; ++b)
+      for (int e = v.start[static_cast<size_t>(b)]; e < v.start[static_cast<size_t>(b) + 1]; ++e)
+        pairs[static_cast<size_t>(v.offset[static_cast<size_t>(e)])].emplace_back(b, v.box[static_cast<size_t>(e)]);
+  }
+}
+
+void FmmStokesletSum::Apply(const Matrix3X& strengths, Matrix3X* w) const {
+  if (use_direct_) return direct_->Apply(strengths, w);
+  SR_ASSERT(strengths.cols() == src_.rows(), "one strength per source");
+  for (Eigen::Index s = 0; s < src_.rows(); ++s)
+    src_.row(s).tail<3>() = strengths.col(tree_.source_order[static_cast<size_t>(s)]).transpose();
+  Upward();
+  Downward();
+  Matrix3X sorted;
+  Leaves(&sorted);
+  w->resize(3, sorted.cols());
+  for (Eigen::Index t = 0; t < sorted.cols(); ++t)
+    w->col(tree_.target_order[static_cast<size_t>(t)]) = sorted.col(t);
+}
+
+// S2M at the leaves, M2M up to level 2, and the projection on the M2L basis.
+void FmmStokesletSum::Upward() const {
+  const int leaf = tree_.depth;
+  const auto& boxes = tree_.levels[static_cast<size_t>(leaf)];
+  const SourceColumns columns = Columns(src_);
+  const double width = tree_.BoxWidth(leaf);
+  MatX& check = check_[static_cast<size_t>(leaf)];
+  const int n = op_->points;
+  check.setZero();
+#pragma omp parallel for schedule(dynamic, 4)
+  for (std::size_t b = 0; b < boxes.size(); ++b) {
+    const FmmBox& box = boxes[b];
+    if (!box.has_sources()) continue;
+    const Vec3 centre = tree_.BoxCentre(leaf, box.code);
+    for (int i = 0; i < n; ++i) {
+      const Vec3 p = centre + (kFmmOuterRadius * width) * op_->surface.col(i);
+      AddPointSum(columns, box.src_begin, box.src_end, p.data(),
+                  check.col(static_cast<Eigen::Index>(b)).data() + 3 * i);
+    }
+  }
+  Gemm(op_->check_to_up, false, check, width, 0.0, &up_[static_cast<size_t>(leaf)]);
+  for (int l = leaf - 1; l >= 2; --l) {
+    const auto& parents = tree_.levels[static_cast<size_t>(l)];
+    const auto& children = tree_.levels[static_cast<size_t>(l) + 1];
+    const MatX& child_up = up_[static_cast<size_t>(l) + 1];
+    MatX& parent_up = up_[static_cast<size_t>(l)];
+#pragma omp parallel for schedule(dynamic, 4)
+    for (std::size_t b = 0; b < parents.size(); ++b) {
+      auto out = parent_up.col(static_cast<Eigen::Index>(b));
+      out.setZero();
+      for (int c = parents[b].child_begin; c < parents[b].child_end; ++c)
+        if (children[static_cast<size_t>(c)].has_sources())
+          out.noalias() += op_->m2m[children[static_cast<size_t>(c)].code & 7] * child_up.col(c);
+    }
+  }
+}
+
+// M2L over the V lists and L2L, level by level from the top.
+void FmmStokesletSum::Downward() const {
+  for (int l = 2; l <= tree_.depth; ++l) {
+    M2l(l);
+    const auto& boxes = tree_.levels[static_cast<size_t>(l)];
+    MatX& down = down_[static_cast<size_t>(l)];
+    Gemm(op_->check_to_down, false, check_[static_cast<size_t>(l)], 1.0, 0.0, &down);
+    if (l == 2) continue;
+    const MatX& parent = down_[static_cast<size_t>(l) - 1];
+#pragma omp parallel for schedule(static)
+    for (std::size_t b = 0; b < boxes.size(); ++b)
+      if (boxes[b].has_targets())
+        down.col(static_cast<Eigen::Index>(b)).noalias() +=
+            op_->l2l[boxes[b].code & 7] * parent.col(boxes[b].parent);
+  }
+}
+
+// The V-list translations of a level into the downward check potentials, batched by offset into
+// one matrix–matrix product each (threaded by the BLAS).
+void FmmStokesletSum::M2l(int level) const {
+  const auto& pairs = m2l_pairs_[static_cast<size_t>(level)];
+  const MatX& up = up_[static_cast<size_t>(level)];
+  MatX& check = check_[static_cast<size_t>(level)];
+  check.setZero();
+  for (int o = 0; o < 343; ++o) {
+    const auto& list = pairs[static_cast<size_t>(o)];
+    const auto m = static_cast<Eigen::Index>(list.size());
+    if (m == 0) continue;
+    m2l_in_.resize(up.rows(), m);
+    for (Eigen::Index j = 0; j < m; ++j) m2l_in_.col(j) = up.col(list[static_cast<size_t>(j)].second);
+    Gemm(M2lMatrix(*op_, o), M2lIsTransposed(o), m2l_in_, 1.0, 0.0, &m2l_out_);
+    for (Eigen::Index j = 0; j < m; ++j) check.col(list[static_cast<size_t>(j)].first) += m2l_out_.col(j);
+  }
+}
+
+// L2T and the near field, leaf by leaf.
+void FmmStokesletSum::Leaves(Matrix3X* w) const {
+  const int leaf = tree_.depth;
+  const auto& boxes = tree_.levels[static_cast<size_t>(leaf)];
+  const SourceColumns columns = Columns(src_);
+  const double width = tree_.BoxWidth(leaf);
+  const int n = op_->points;
+  w->setZero(3, x_.cols());
+#pragma omp parallel
+  {
+    MatX surface(n, 7);  // the downward equivalent densities as sources, ε = 0
+    surface.col(3).setZero();
+#pragma omp for schedule(dynamic, 4)
+    for (std::size_t b = 0; b < boxes.size(); ++b) {
+      const FmmBox& box = boxes[b];
+      if (!box.has_targets()) continue;
+      const Vec3 centre = tree_.BoxCentre(leaf, box.code);
+      surface.leftCols<3>() =
+          ((kFmmOuterRadius * width * op_->surface).colwise() + centre).transpose();
+      surface.rightCols<3>() =
+          Eigen::Map<const Matrix3X>(down_[static_cast<size_t>(leaf)].col(static_cast<Eigen::Index>(b)).data(), 3, n)
+              .transpose();
+      const SourceColumns far = Columns(surface);
+      for (int t = box.tgt_begin; t < box.tgt_end; ++t) {
+        double* out = w->col(t).data();
+        AddPointSum(far, 0, n, x_.col(t).data(), out);
+        for (int e = tree_.near.start[b]; e < tree_.near.start[b + 1]; ++e) {
+          const FmmBox& a = boxes[static_cast<size_t>(tree_.near.box[static_cast<size_t>(e)])];
+          AddPointSum(columns, a.src_begin, a.src_end, x_.col(t).data(), out);
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+
+std::unique_ptr<StokesletSum> MakeFastStokesletSum(const StokesletSumOptions& options) {
+  return std::make_unique<FmmStokesletSum>(options);
+}
+
+}  // namespace stokesrods

@@ -1,0 +1,223 @@
+#include "stokesrods/fluid/fmm_tree.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include "stokesrods/fluid/fmm_operators.h"
+
+namespace stokesrods {
+namespace {
+
+constexpr int kMaxLevel = 20;  // Morton codes of 3 × 20 bits
+
+std::uint64_t Spread(std::uint64_t v) {  // bits b → 3b
+  v &= 0x1fffff;
+  v = (v | v << 32) & 0x1f00000000ffffULL;
+  v = (v | v << 16) & 0x1f0000ff0000ffULL;
+  v = (v | v << 8) & 0x100f00f00f00f00fULL;
+  v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+  v = (v | v << 2) & 0x1249249249249249ULL;
+  return v;
+}
+
+std::uint64_t Compact(std::uint64_t v) {  // bits 3b → b
+  v &= 0x1249249249249249ULL;
+  v = (v ^ (v >> 2)) & 0x10c30c30c30c30c3ULL;
+  v = (v ^ (v >> 4)) & 0x100f00f00f00f00fULL;
+  v = (v ^ (v >> 8)) & 0x1f0000ff0000ffULL;
+  v = (v ^ (v >> 16)) & 0x1f00000000ffffULL;
+  v = (v ^ (v >> 32)) & 0x1fffff;
+  return v;
+}
+
+std::uint64_t Encode(const std::array<std::int64_t, 3>& i) {
+  return Spread(static_cast<std::uint64_t>(i[0])) << 2 | Spread(static_cast<std::uint64_t>(i[1])) << 1 |
+         Spread(static_cast<std::uint64_t>(i[2]));
+}
+
+std::array<std::int64_t, 3> Decode(std::uint64_t code) {
+  return {static_cast<std::int64_t>(Compact(code >> 2)), static_cast<std::int64_t>(Compact(code >> 1)),
+          static_cast<std::int64_t>(Compact(code))};
+}
+
+/// Sorts the points by Morton code at kMaxLevel: the order and the sorted codes.
+std::vector<std::uint64_t> SortByCode(const Matrix3X& p, const Vec3& corner, double width,
+                                      std::vector<int>* order) {
+  const double cells = static_cast<double>(1 << kMaxLevel);
+  std::vector<std::pair<std::uint64_t, int>> keyed(static_cast<size_t>(p.cols()));
+  for (Eigen::Index k = 0; k < p.cols(); ++k) {
+    std::array<std::int64_t, 3> i{};
+    for (int d = 0; d < 3; ++d)
+      i[static_cast<size_t>(d)] = std::clamp<std::int64_t>(
+          static_cast<std::int64_t>((p(d, k) - corner[d]) / width * cells), 0, (1 << kMaxLevel) - 1);
+    keyed[static_cast<size_t>(k)] = {Encode(i), static_cast<int>(k)};
+  }
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<std::uint64_t> codes;
+  order->clear();
+  for (const auto& [code, k] : keyed) {
+    codes.push_back(code);
+    order->push_back(k);
+  }
+  return codes;
+}
+
+/// The boxes of `level`: the distinct prefixes of the sorted codes of sources and targets.
+std::vector<FmmBox> MakeLevel(int level, const std::vector<std::uint64_t>& src,
+                              const std::vector<std::uint64_t>& tgt) {
+  const int shift = 3 * (kMaxLevel - level);
+  std::vector<FmmBox> boxes;
+  std::size_t s = 0, t = 0;
+  while (s < src.size() || t < tgt.size()) {
+    const std::uint64_t code = std::min(s < src.size() ? src[s] >> shift : ~0ULL,
+                                        t < tgt.size() ? tgt[t] >> shift : ~0ULL);
+    FmmBox box;
+    box.code = code;
+    box.src_begin = static_cast<int>(s);
+    while (s < src.size() && src[s] >> shift == code) ++s;
+    box.src_end = static_cast<int>(s);
+    box.tgt_begin = static_cast<int>(t);
+    while (t < tgt.size() && tgt[t] >> shift == code) ++t;
+    box.tgt_end = static_cast<int>(t);
+    boxes.push_back(box);
+  }
+  return boxes;
+}
+
+/// Links the boxes of a level to their parents (both sorted by code).
+void LinkParents(std::vector<FmmBox>* parents, std::vector<FmmBox>* children) {
+  std::size_t p = 0;
+  for (std::size_t c = 0; c < children->size(); ++c) {
+    while ((*parents)[p].code != (*children)[c].code >> 3) ++p;
+    if ((*parents)[p].child_end == 0) (*parents)[p].child_begin = static_cast<int>(c);
+    (*parents)[p].child_end = static_cast<int>(c) + 1;
+    (*children)[c].parent = static_cast<int>(p);
+  }
+}
+
+/// Index of the box with this code at this level, or −1.
+int Find(const std::vector<FmmBox>& boxes, int level, const std::array<std::int64_t, 3>& i) {
+  const std::int64_t n = std::int64_t{1} << level;
+  for (std::int64_t v : i)
+    if (v < 0 || v >= n) return -1;
+  const std::uint64_t code = Encode(i);
+  const auto it = std::lower_bound(boxes.begin(), boxes.end(), code,
+                                   [](const FmmBox& b, std::uint64_t c) { return b.code < c; });
+  return it != boxes.end() && it->code == code ? static_cast<int>(it - boxes.begin()) : -1;
+}
+
+/// Calls f(index) for every existing neighbour (incl. the box itself) of box i at a level.
+template <typename F>
+void ForNeighbours(const std::vector<FmmBox>& boxes, int level, std::uint64_t code, F f) {
+  const auto c = Decode(code);
+  for (int dx = -1; dx <= 1; ++dx)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dz = -1; dz <= 1; ++dz) {
+        const int k = Find(boxes, level, {c[0] + dx, c[1] + dy, c[2] + dz});
+        if (k >= 0) f(k);
+      }
+}
+
+/// The V lists of a level ≥ 2: children of the parent's neighbours that have sources and are not
+/// neighbours, for the boxes with targets.
+FmmList MakeVList(const std::vector<FmmBox>& parents, const std::vector<FmmBox>& boxes, int level) {
+  FmmList list;
+  for (const FmmBox& b : boxes) {
+    if (b.has_targets()) {
+      const auto bc = Decode(b.code);
+      ForNeighbours(parents, level - 1, parents[static_cast<size_t>(b.parent)].code, [&](int p) {
+        const FmmBox& pn = parents[static_cast<size_t>(p)];
+        for (int c = pn.child_begin; c < pn.child_end; ++c) {
+          const FmmBox& a = boxes[static_cast<size_t>(c)];
+          const auto ac = Decode(a.code);
+          const std::int64_t vx = ac[0] - bc[0], vy = ac[1] - bc[1], vz = ac[2] - bc[2];
+          if (!a.has_sources() || std::max({std::abs(vx), std::abs(vy), std::abs(vz)}) < 2) continue;
+          list.box.push_back(c);
+          list.offset.push_back(M2lIndex(static_cast<int>(vx), static_cast<int>(vy), static_cast<int>(vz)));
+        }
+      });
+    }
+    list.start.push_back(static_cast<int>(list.box.size()));
+  }
+  return list;
+}
+
+/// The near lists of the leaf level and the number of (target, source) pairs in them.
+FmmList MakeNearList(const std::vector<FmmBox>& boxes, int level, std::int64_t* pairs) {
+  FmmList list;
+  *pairs = 0;
+  for (const FmmBox& b : boxes) {
+    if (b.has_targets())
+      ForNeighbours(boxes, level, b.code, [&](int k) {
+        const FmmBox& a = boxes[static_cast<size_t>(k)];
+        if (!a.has_sources()) return;
+        list.box.push_back(k);
+        *pairs += static_cast<std::int64_t>(b.tgt_end - b.tgt_begin) * (a.src_end - a.src_begin);
+      });
+    list.start.push_back(static_cast<int>(list.box.size()));
+  }
+  return list;
+}
+
+}  // namespace
+
+Vec3 FmmTree::BoxCentre(int level, std::uint64_t code) const {
+  const auto i = Decode(code);
+  const double w = BoxWidth(level);
+  return corner + w * Vec3(static_cast<double>(i[0]) + 0.5, static_cast<double>(i[1]) + 0.5,
+                           static_cast<double>(i[2]) + 0.5);
+}
+
+FmmTree BuildFmmTree(const Matrix3X& sources, const Matrix3X& targets, double min_leaf_width,
+                     const FmmCost& cost, bool force_tree) {
+  FmmTree tree;
+  if (sources.cols() == 0 || targets.cols() == 0) return tree;
+  const Vec3 lo = sources.rowwise().minCoeff().cwiseMin(targets.rowwise().minCoeff());
+  const Vec3 hi = sources.rowwise().maxCoeff().cwiseMax(targets.rowwise().maxCoeff());
+  const double extent = (hi - lo).maxCoeff();
+  if (!(extent > 0.0) || !std::isfinite(extent)) return tree;
+  tree.width = extent * (1.0 + 1e-9);
+  tree.corner = 0.5 * (lo + hi) - Vec3::Constant(0.5 * tree.width);
+  const auto src = SortByCode(sources, tree.corner, tree.width, &tree.source_order);
+  const auto tgt = SortByCode(targets, tree.corner, tree.width, &tree.target_order);
+  const double pairs = static_cast<double>(sources.cols()) * static_cast<double>(targets.cols());
+  const double points = static_cast<double>(sources.cols() + targets.cols());
+  tree.levels.push_back(MakeLevel(0, src, tgt));
+  tree.levels.push_back(MakeLevel(1, src, tgt));
+  LinkParents(&tree.levels[0], &tree.levels[1]);
+  tree.v_lists.resize(2);
+  double far_cost = cost.per_point * points, best = std::numeric_limits<double>::infinity();
+  std::int64_t m2l = 0;
+  for (int level = 2; level <= kMaxLevel && tree.BoxWidth(level) >= min_leaf_width; ++level) {
+    tree.levels.push_back(MakeLevel(level, src, tgt));
+    LinkParents(&tree.levels[static_cast<size_t>(level) - 1], &tree.levels.back());
+    tree.v_lists.push_back(MakeVList(tree.levels[static_cast<size_t>(level) - 1], tree.levels.back(), level));
+    m2l += static_cast<std::int64_t>(tree.v_lists.back().box.size());
+    std::vector<char> used(343, 0);
+    for (int o : tree.v_lists.back().offset) used[static_cast<size_t>(o)] = 1;
+    far_cost += cost.per_offset * static_cast<double>(std::count(used.begin(), used.end(), 1));
+    far_cost += cost.per_box * static_cast<double>(tree.levels.back().size()) +
+                cost.per_m2l * static_cast<double>(tree.v_lists.back().box.size());
+    std::int64_t near = 0;
+    MakeNearList(tree.levels.back(), level, &near);
+    const double total = far_cost + static_cast<double>(near);
+    if (total < best) {
+      best = total;
+      tree.depth = level;
+      tree.m2l_count = m2l;
+    }
+    // The cost is convex in the depth: stop once it has clearly turned.
+    if (total > 2.0 * best || tree.levels.back().size() >= static_cast<size_t>(sources.cols() + targets.cols())) break;
+  }
+  if (tree.depth == 0 || (!force_tree && best >= pairs)) return FmmTree{};
+  tree.levels.resize(static_cast<size_t>(tree.depth) + 1);
+  tree.v_lists.resize(static_cast<size_t>(tree.depth) + 1);
+  tree.near = MakeNearList(tree.levels.back(), tree.depth, &tree.near_pairs);
+  tree.cost = best;
+  return tree;
+}
+
+}  // namespace stokesrods
