@@ -28,7 +28,7 @@ namespace stokesrods {
 struct FmmOperators {
   int order = 0;                 ///< p, points per edge of the surfaces
   int points = 0;                ///< n = p³ − (p − 2)³ points on a surface
-  double cutoff = 0.0;           ///< relative singular-value cutoff of the basis and inverses
+  double cutoff = 0.0;           ///< relative singular-value cutoff of the pseudo-inverses
   Matrix3X surface;              ///< the n points on the cube of ∞-radius 1
   MatX check_to_up;              ///< upward check (r_out) → upward equivalent (r_in) densities
   std::array<MatX, 8> m2m;       ///< child c's upward densities → the parent's
@@ -40,8 +40,9 @@ struct FmmOperators {
 inline constexpr double kFmmInnerRadius = 0.525;  ///< r_in in box widths
 inline constexpr double kFmmOuterRadius = 1.475;  ///< r_out in box widths
 
-/// The operators for p = order (2 ≤ p ≤ 12) and the relative cutoff of the pseudo-inverses and of
-/// the M2L basis; computed on first use (thread-safe), then cached for the process.
+/// The operators for p = order (2 ≤ p ≤ 12) and the relative cutoff of the pseudo-inverses;
+/// computed on first use (thread-safe; 0.1, 0.4, 1.5 s for p = 4, 5, 6), then cached for the
+/// process (K_v: 36, 110, 260 MB).
 const FmmOperators& GetFmmOperators(int order, double cutoff);
 
 /// Index of offset v in FmmOperators::m2l; index 342 − i is offset −v.

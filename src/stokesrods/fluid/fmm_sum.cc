@@ -2,24 +2,33 @@
 // octree (fmm_tree.h) with precomputed, width-independent translation operators (fmm_operators.h).
 //
 // Apply: S2M (the leaf's sources, with their own regularized kernel, evaluated on the upward check
-// surface and fitted by upward equivalent densities), M2M up to level 2, M2L (compressed, k × k) over
-// the V lists of every level, L2L down, L2T (the downward equivalent densities evaluated at the
-// targets), and the near field (the 27 neighbouring leaves) summed directly with the regularized
-// kernel by the vectorized loop of the direct sum. Every box's work is done by one thread, in a
-// fixed order: Apply is deterministic.
+// surface and fitted by upward equivalent densities), M2M up to level 2, M2L over the V lists of
+// every level (the dense K_v, all pairs of one offset in one BLAS product), L2L down, L2T (the
+// downward equivalent densities evaluated at the targets), and the near field (the 27 neighbouring
+// leaves) summed directly with the regularized kernel by the vectorized loop of the direct sum.
+// Every box's work is done by one thread, in a fixed order: Apply is deterministic.
+//
+// DEPTH. The tree is cut at the depth of least estimated cost (FmmCost: kernel evaluations of the
+// near field, S2M and L2T, the translations per box and per M2L, and reading each K_v used), and
+// the sum is direct where that cost is not below S·T (unless forced, for tests). On the 100-helix
+// lattice this is depth 2 (boxes 0.1 m wide): 35 % of the pairs stay near, so one Apply costs
+// about 0.45 of the direct sum at p = 4 and 0.6 at p = 5, and the tree does not pay at p = 6
+// (bench_stokeslet_sum); deeper, each M2L (3n × 3n = 168² at p = 4) costs as much as summing
+// the two boxes' 30–70 points directly.
 //
 // REGULARIZATION. Far (V-list) pairs are approximated by Stokes flows, while S_ε is one only up
 // to O((ε/r)⁴): S_ε = S + (ε²/2)(I − 3 r̂r̂ᵀ)/r³ + ε⁴(−9/8 I + 15/8 r̂r̂ᵀ)/r⁵ + …, whose ε² term
 // (a potential dipole) is a Stokes flow the equivalent densities reproduce (S2M uses S_ε itself)
 // and whose ε⁴ term is not. Far pairs are at least a leaf width w apart, so leaves are kept no
 // narrower than w_min = ε_max (c_ε / tolerance)^(1/4), which bounds that part of the error by
-// the tolerance (c_ε below, measured).
+// the tolerance: c_ε = 2 bounds the coefficients of the ε⁴ term (15/8); the test
+// MixedRegularizationAndTargetsOnSources runs at that bound.
 #include <algorithm>
 #include <array>
-#include <utility>
-#include <vector>
 #include <cmath>
 #include <memory>
+#include <utility>
+#include <vector>
 
 #include "stokesrods/common/assert.h"
 #include "stokesrods/fluid/fmm_operators.h"

@@ -38,7 +38,7 @@ struct MobilityOptions {
   double direct_sum_below = 4e6;
   /// Matrix-free: the FMM's bound on the error of the far-field sum, relative per node to
   /// Σ |S||g| over the Gauss points (stokeslet_sum.h); it sets the expansion order (fmm_sum.cc) [–].
-  double fast_sum_tolerance = 1e-5;
+  double fast_sum_tolerance = 1e-4;
   /// Matrix-free: false uses the FMM whenever the geometry allows it, paying or not (tests).
   bool fast_sum_by_cost = true;
 };

@@ -8,8 +8,10 @@
 // stokeslet_segment.h). The positions are fixed by Build; Apply is then called many times with
 // different source strengths g (a Krylov solve within one time step).
 //
-// Two implementations behind one interface: the direct O(S T) sum (the reference) and a fast
-// summation whose relative error is bounded by `tolerance` (tests/fluid/stokeslet_sum_test.cc).
+// Two implementations behind one interface: the direct O(S T) sum (the reference) and a
+// kernel-independent fast multipole method (fmm_sum.cc) whose error, measured on clouds and helix
+// lattices, is within `tolerance` (tests/fluid/stokeslet_sum_test.cc); it sums directly where its
+// cost model says the tree would not pay.
 #pragma once
 
 #include <cstdint>

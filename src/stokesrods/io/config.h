@@ -49,7 +49,7 @@ struct FluidConfig {
   /// "auto" (dense up to 500 nodes, else matrix-free) | "dense" | "matrix_free" (RSS only)
   std::string mobility = "auto";
   double far_field_tolerance = 1e-8;  ///< matrix-free: relative error of the far field [–]
-  double fast_sum_tolerance = 1e-5;   ///< matrix-free: error bound of the FMM far-field sum [–]
+  double fast_sum_tolerance = 1e-4;   ///< matrix-free: error bound of the FMM far-field sum [–]
   std::string solver = "krylov";      ///< implicit coupling: "krylov" (GMRES) | "direct" (dense LU)
   double krylov_tolerance = 1e-6;     ///< GMRES relative residual [–]
 };
