@@ -49,18 +49,7 @@ double Error(const Lattice& c, const Matrix3X& g, const Matrix3X& w) {
   direct->Build(c.sources, c.regularization, c.targets);
   Matrix3X ref;
   direct->Apply(g, &ref);
-  double worst = 0.0;
-  for (Eigen::Index t = 0; t < c.targets.cols(); ++t) {
-    double scale = 0.0;
-    for (Eigen::Index s = 0; s < c.sources.cols(); ++s) {
-      const Vec3 r = c.targets.col(t) - c.sources.col(s);
-      const double e2 = c.regularization[s] * c.regularization[s];
-      const double big_r = std::sqrt(r.squaredNorm() + e2);
-      scale += (1.0 / big_r + (e2 + r.squaredNorm()) / (big_r * big_r * big_r)) * g.col(s).norm();
-    }
-    worst = std::max(worst, (w.col(t) - ref.col(t)).norm() / scale);
-  }
-  return worst;
+  return testing::StokesletSumError(c, g, w, ref);
 }
 
 void SetCounters(benchmark::State& st, const StokesletSum& sum, const Lattice& c) {

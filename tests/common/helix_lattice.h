@@ -1,8 +1,9 @@
 // The helix lattice of the Stokeslet-sum tests and benchmark: helices of 65 nodes (radius 0.01 m,
 // pitch 0.05 m, axis 0.2 m along −z) on a square lattice 0.04 m apart; sources: 2 Gauss points
-// per segment, ε = 1.02e-3 m; targets: the nodes.
+// per segment, ε = 1.02e-3 m; targets: the nodes. And the error measure of the Stokeslet sums.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
 #include "stokesrods/common/types.h"
@@ -36,6 +37,24 @@ inline PointCloud HelixLattice(int rows, int cols) {
   }
   c.regularization = VecX::Constant(ns, 1.02e-3);
   return c;
+}
+
+/// The error measure of stokeslet_sum.h: max over targets of |w − w_ref| / Σ_s |S(x_t − y_s)|₂ |g_s|.
+inline double StokesletSumError(const PointCloud& c, const Matrix3X& g, const Matrix3X& w,
+                                const Matrix3X& ref) {
+  double worst = 0.0;
+  for (Eigen::Index t = 0; t < c.targets.cols(); ++t) {
+    double scale = 0.0;
+    for (Eigen::Index s = 0; s < c.sources.cols(); ++s) {
+      const Vec3 r = c.targets.col(t) - c.sources.col(s);
+      const double e2 = c.regularization[s] * c.regularization[s];
+      const double big_r = std::sqrt(r.squaredNorm() + e2);
+      // The eigenvalues of S_ε are 1/R + ε²/R³ (twice) and 1/R + (ε² + r²)/R³, the largest.
+      scale += (1.0 / big_r + (e2 + r.squaredNorm()) / (big_r * big_r * big_r)) * g.col(s).norm();
+    }
+    worst = std::max(worst, (w.col(t) - ref.col(t)).norm() / scale);
+  }
+  return worst;
 }
 
 }  // namespace stokesrods::testing

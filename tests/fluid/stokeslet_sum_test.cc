@@ -38,23 +38,6 @@ Cloud RandomCloud(int ns, int nt, double size, double eps, std::mt19937* rng) {
 
 using testing::HelixLattice;
 
-// max over targets of |w − w_ref| / Σ_s |S(x_t − y_s)|₂ |g_s|, the error measure of the header.
-double RelativeError(const Cloud& c, const Matrix3X& g, const Matrix3X& w, const Matrix3X& ref) {
-  double worst = 0.0;
-  for (int t = 0; t < c.targets.cols(); ++t) {
-    double scale = 0.0;
-    for (int s = 0; s < c.sources.cols(); ++s) {
-      const Vec3 r = c.targets.col(t) - c.sources.col(s);
-      const double e2 = c.regularization[s] * c.regularization[s];
-      const double big_r = std::sqrt(r.squaredNorm() + e2);
-      // The eigenvalues of S_ε are 1/R + ε²/R³ (twice) and 1/R + (ε² + r²)/R³, the largest.
-      scale += (1.0 / big_r + (e2 + r.squaredNorm()) / (big_r * big_r * big_r)) * g.col(s).norm();
-    }
-    worst = std::max(worst, (w.col(t) - ref.col(t)).norm() / scale);
-  }
-  return worst;
-}
-
 struct Result {
   double error = 0.0;
   StokesletSumStats stats;
@@ -75,7 +58,7 @@ Result Compare(const Cloud& c, StokesletSumOptions options, std::mt19937* rng) {
   EXPECT_TRUE(w == w2) << "Apply is not repeatable";
   const StokesletSumStats stats = fast->Stats();
   EXPECT_EQ(stats.near_pairs + stats.far_pairs, c.sources.cols() * c.targets.cols());
-  return {RelativeError(c, g, w, ref), fast->Stats()};
+  return {testing::StokesletSumError(c, g, w, ref), fast->Stats()};
 }
 
 TEST(StokesletSumTest, DirectSumMatchesTheKernel) {
