@@ -170,6 +170,14 @@ void CheckSelfOverlap(const Config& config, const Model& model) {
 
 }  // namespace
 
+void SetRodOmega(RodModel* rod, double omega) {
+  // The imposed rotation vector is +ω ẑ: the first material frame turns about ẑ, i.e. about
+  // its own tangent t⁰ at the rate ω (ẑ · t⁰) (t⁰ = −ẑ for the hanging helix: θ0 decreases).
+  const Vec3 t0 = (rod->rest_positions.col(1) - rod->rest_positions.col(0)).normalized();
+  rod->omega = omega;
+  rod->twist_rate = omega * t0.z();
+}
+
 Model BuildModel(const Config& config) {
   Model model;
   model.fluid.model = ParseFluidModel(config.fluid.model);
@@ -208,16 +216,13 @@ Model BuildModel(const Config& config) {
     rod.axis_length = rc.axis_length;
     rod.helix_radius = rc.shape == "helix" ? rc.helix_radius : 0.0;
     // ω about +ẑ; omega_bar = ω μ l0⁴ / EI (SPEC).
-    rod.omega = rc.omega ? *rc.omega
+    const double omega = rc.omega ? *rc.omega
                 : rc.omega_bar ? *rc.omega_bar * rod.bending_stiffness /
                                      (config.fluid.viscosity * std::pow(rc.axis_length, 4))
                                : 0.0;
     for (const PointLoadConfig& l : rc.loads) rod.loads.push_back({l.node, l.force});
     FinalizeRod(&rod);
-    // The imposed rotation vector is +ω ẑ: the first material frame turns about ẑ, i.e. about
-    // its own tangent t⁰ at the rate ω (ẑ · t⁰) (t⁰ = −ẑ for the hanging helix: θ0 decreases).
-    const Vec3 t0 = (rod.rest_positions.col(1) - rod.rest_positions.col(0)).normalized();
-    rod.twist_rate = rod.omega * t0.z();
+    SetRodOmega(&rod, omega);
     model.rods.push_back(std::move(rod));
   }
   FinalizeLayout(&model);

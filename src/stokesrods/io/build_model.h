@@ -32,6 +32,9 @@ constexpr double kMaxSteps = 1e12;
 /// (rods overlapping at the start, a model not available, ...).
 Model BuildModel(const Config& config);
 
+/// Sets the rod's imposed rotation rate ω about +ẑ [rad/s] (rod.omega and the twist rate of θ0).
+void SetRodOmega(RodModel* rod, double omega);
+
 /// The largest time step for which fluid.coupling = "explicit" is stable at the rest shape [s]
 /// (the drag as forward Euler on the free nodes: h ≤ 2 Re λ/|λ|² over the eigenvalues λ of
 /// M⁻¹ (𝕄⁻¹)_ff, about 2 m/c for node mass m and node drag coefficient c).

@@ -12,6 +12,7 @@
 #include "stokesrods/io/build_model.h"
 #include "stokesrods/io/checkpoint.h"
 #include "stokesrods/io/flow_field.h"
+#include "stokesrods/io/simulation.h"
 #include "stokesrods/io/writers.h"
 #include "stokesrods/sim/integrator.h"
 #include "stokesrods/sim/observables.h"
@@ -132,15 +133,16 @@ RunResult RunCase(const Config& config, const RunOptions& options) {
   auto wall = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
-  const Model model = BuildModel(config);
-  const RunPlan plan = MakeRunPlan(config, model);
+  Simulation sim(config);
+  const Model& model = sim.model();
+  const RunPlan& plan = sim.plan();
   std::error_code ec;
   fs::create_directories(plan.output_dir, ec);
   if (ec) throw IoError(fmt::format("{}: cannot create the output directory: {}", plan.output_dir, ec.message()));
   const std::string checkpoint = (fs::path(plan.output_dir) / "checkpoint.bin").string();
 
-  State state = MakeRestState(model);
-  Workspace ws(model);
+  State& state = sim.state();
+  Workspace& ws = sim.workspace();
   RunCounters counters;
   const long kept_rows =
       options.resume ? Resume(config, model, plan, checkpoint, &state, &ws, &counters) : 0;
@@ -151,7 +153,7 @@ RunResult RunCase(const Config& config, const RunOptions& options) {
   report.ok = true;
 
   if (plan.static_mode) {
-    report = SolveStatic(model, &state, &ws);
+    report = sim.SolveStatic();
     result.newton_iterations = report.newton_iterations;
     result.wall_seconds = wall();
     result.status = report.ok ? RunStatus::kCompleted : RunStatus::kFailed;
@@ -201,7 +203,7 @@ RunResult RunCase(const Config& config, const RunOptions& options) {
       result.message = fmt::format("interrupted at t = {:.6g} s", state.time);
       break;
     }
-    report = Step(model, h, &state, &ws);
+    report = sim.Step();
     counters.newton_iterations += report.newton_iterations;
     if (!report.ok) {
       result.status = RunStatus::kFailed;
