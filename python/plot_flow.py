@@ -15,7 +15,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from stokesrods_frames import nearest_frames, read_frame  # noqa: E402
+from stokesrods.results import nearest_frames, read_frame  # noqa: E402
 
 
 def main():

@@ -13,7 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.ticker  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from stokesrods_frames import nearest_frames, read_frame  # noqa: E402
+from stokesrods.results import nearest_frames, read_frame  # noqa: E402
 
 COLORS = ["tab:blue", "tab:red", "tab:green", "tab:orange", "tab:purple"]
 
