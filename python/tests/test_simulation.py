@@ -16,13 +16,15 @@ def test_stepping_reproduces_run(tmp_path, small):
     assert sim.time == 0 and sim.time_step == 0.02
     sim.step(15)
     assert sim.time == pytest.approx(0.3) and sim.steps == 15
+    # A run forgets its reused Newton factors at its restart points (exact resume), a Simulation
+    # keeps them: the two agree to the Newton tolerance (1e-8 of the force scale), not digit for digit.
     final = result.summary["final"]
     for name, value in sim.observables().items():
         if value == value and name != "newton_iterations":  # not NaN
-            assert value == pytest.approx(final[name], rel=1e-11, abs=1e-14), name
+            assert value == pytest.approx(final[name], rel=1e-8, abs=1e-12), name
     np.testing.assert_allclose(sim.positions(2), result.positions[-1][1], rtol=0, atol=1e-10)
     load = sim.clamp_load(1)
-    np.testing.assert_allclose(load["force"], [final[f"rod1_force_{a}"] for a in "xyz"], rtol=1e-11)
+    np.testing.assert_allclose(load["force"], [final[f"rod1_force_{a}"] for a in "xyz"], rtol=1e-8)
     assert sim.velocities(1).shape == (21, 3) and sim.twist_angles(1).shape == (20,)
     with pytest.raises(IndexError, match="rod 3 does not exist"):
         sim.positions(3)
