@@ -14,6 +14,7 @@
 #include "stokesrods/io/config.h"
 #include "stokesrods/io/runner.h"
 #include "stokesrods/io/writers.h"
+#include "python_tools.h"
 
 namespace {
 
@@ -68,6 +69,14 @@ int main(int argc, char** argv) {
   show->add_option("config", config_path, "configuration file (TOML)")->required();
   show->add_option("--set", overrides, "override one key: KEY=VALUE");
 
+  CLI::App* render = stokesrods::AddPythonTool(
+      &app, "render",
+      "pictures of a run: RUN_DIR [--times T...] [--color rod|contact_force|hydrodynamic_force] "
+      "[--no-video] [--fps N] [--max-frames N] [--output-dir DIR]; writes RUN_DIR/render/"
+      "{views.png,run.mp4,flow.png}");
+  CLI::App* plot = stokesrods::AddPythonTool(
+      &app, "plot", "time series of a run: RUN_DIR COLUMN... [--x time|t_bar] [--output FILE]");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -75,6 +84,8 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : 2;
   }
 
+  if (*render) return stokesrods::RunPythonTool("render", render->remaining());
+  if (*plot) return stokesrods::RunPythonTool("plot", plot->remaining());
   try {
     if (!output.empty()) overrides.push_back("run.output=\"" + output + "\"");
     const stokesrods::Config config = stokesrods::LoadConfig(config_path, overrides);

@@ -1,5 +1,6 @@
 #include "stokesrods/io/config.h"
 
+#include <cmath>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -264,20 +265,25 @@ void ReadSection(const toml::table& root, const char* name, const std::string& f
   reader.RejectUnknownKeys();
 }
 
+// The sections other than [[rods]], in the order show-config prints them.
+template <class F>
+void VisitSections(Config& c, F f) {
+  f("run", c.run);
+  f("fluid", c.fluid);
+  f("contact", c.contact);
+  f("gravity", c.gravity);
+  f("solver", c.solver);
+  f("flow_field", c.flow_field);
+}
+
 toml::table ToTable(Config& c) {
   toml::table root;
-  auto section = [&](const char* name, auto& s) {
+  VisitSections(c, [&](const char* name, auto& s) {
     toml::table t;
     Writer w(&t);
     VisitFields(s, w);
     root.insert_or_assign(name, std::move(t));
-  };
-  section("run", c.run);
-  section("fluid", c.fluid);
-  section("contact", c.contact);
-  section("gravity", c.gravity);
-  section("solver", c.solver);
-  section("flow_field", c.flow_field);
+  });
   toml::array rods;
   for (RodConfig& r : c.rods) {
     toml::table t;
@@ -289,6 +295,120 @@ toml::table ToTable(Config& c) {
   return root;
 }
 
+// ---- TOML text with the shortest numbers that read back the same (0.2, not 0.20000000000000001).
+
+std::string ValueText(const toml::node& node);
+
+std::string QuotedString(const std::string& s) {
+  std::string out = "\"";
+  for (char ch : s) {
+    if (ch == '"' || ch == '\\') out += '\\';
+    if (static_cast<unsigned char>(ch) < 0x20) {
+      out += fmt::format("\\u{:04X}", static_cast<int>(ch));
+      continue;
+    }
+    out += ch;
+  }
+  return out + "\"";
+}
+
+std::string InlineTable(const toml::table& t) {
+  std::string out = "{ ";
+  for (const auto& [key, node] : t) out += fmt::format("{}{} = {}", out.size() > 2 ? ", " : "", key.str(), ValueText(node));
+  return out + " }";
+}
+
+std::string ValueText(const toml::node& node) {
+  if (const auto* d = node.as_floating_point()) {
+    const double v = d->get();
+    if (std::isnan(v)) return "nan";
+    if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+    std::string text = fmt::format("{}", v);  // shortest round trip
+    if (text.find_first_of(".e") == std::string::npos) text += ".0";
+    return text;
+  }
+  if (const auto* a = node.as_array()) {
+    std::string out = "[";
+    for (std::size_t i = 0; i < a->size(); ++i) out += (i ? ", " : "") + ValueText(*a->get(i));
+    return out + "]";
+  }
+  if (const auto* t = node.as_table()) return InlineTable(*t);
+  if (const auto* str = node.as_string()) return QuotedString(str->get());
+  std::stringstream out;
+  node.visit([&out](const auto& v) { out << v; });
+  return out.str();
+}
+
+// "key = value" lines in the order of the field list.
+class TextWriter {
+ public:
+  explicit TextWriter(std::string* out) : out_(out) {}
+  template <class T>
+  void operator()(const char* key, T& field) {
+    toml::table t;
+    Writer writer(&t);
+    writer(key, field);
+    if (const toml::node* node = t.get(key)) *out_ += fmt::format("{} = {}\n", key, ValueText(*node));
+  }
+
+ private:
+  std::string* out_;
+};
+
+std::string TomlText(Config& c) {
+  std::string out;
+  TextWriter writer(&out);
+  VisitSections(c, [&](const char* name, auto& section) {
+    out += fmt::format("{}[{}]\n", out.empty() ? "" : "\n", name);
+    VisitFields(section, writer);
+  });
+  for (RodConfig& rod : c.rods) {
+    out += "\n[[rods]]\n";
+    VisitFields(rod, writer);
+  }
+  return out;
+}
+
+// ---- The list of keys (docs/config_keys.md). -------------------------------------------------
+
+class KeyLister {
+ public:
+  KeyLister(std::string prefix, std::vector<ConfigKey>* out) : prefix_(std::move(prefix)), out_(out) {}
+  template <class T>
+  void operator()(const char* key, T& field) {
+    toml::table t;
+    Writer writer(&t);
+    writer(key, field);
+    const toml::node* node = t.get(key);
+    const std::string value = node ? ValueText(*node) : "";
+    out_->push_back({prefix_ + "." + key, TypeName(field), value == "\"\"" ? "" : value});
+    Nested(prefix_ + "." + key, field);
+  }
+
+ private:
+  static const char* TypeName(const std::string&) { return "string"; }
+  static const char* TypeName(double) { return "number"; }
+  static const char* TypeName(const std::optional<double>&) { return "number"; }
+  static const char* TypeName(int) { return "integer"; }
+  static const char* TypeName(bool) { return "boolean"; }
+  static const char* TypeName(const Vec3&) { return "[x, y, z]"; }
+  static const char* TypeName(const std::vector<double>&) { return "array of numbers"; }
+  static const char* TypeName(const std::vector<int>&) { return "array of integers"; }
+  static const char* TypeName(const std::vector<Vec3>&) { return "array of [x, y, z]"; }
+  template <class S>
+  static const char* TypeName(const std::vector<S>&) { return "array of tables"; }
+  template <class T>
+  void Nested(const std::string&, T&) {}
+  void Nested(const std::string& path, std::vector<PointLoadConfig>&) {
+    PointLoadConfig item;
+    KeyLister inner(path + "[]", out_);
+    VisitFields(item, inner);
+  }
+
+  std::string prefix_;
+  std::vector<ConfigKey>* out_;
+};
+
 // ---- --set overrides. -----------------------------------------------------------------------
 
 std::vector<std::string> Split(const std::string& s, char sep) {
@@ -298,11 +418,22 @@ std::vector<std::string> Split(const std::string& s, char sep) {
   return parts;
 }
 
+// Keys of which a configuration gives exactly one: an override of one replaces the other
+// (--set run.duration=5 on a file that sets run.t_bar_end).
+const char* AlternativeKey(const std::string& key) {
+  if (key == "duration") return "t_bar_end";
+  if (key == "t_bar_end") return "duration";
+  if (key == "omega") return "omega_bar";
+  if (key == "omega_bar") return "omega";
+  return nullptr;
+}
+
 void SetKey(toml::table* table, const std::vector<std::string>& path, std::size_t i,
             const toml::node_view<toml::node>& value, const std::string& file,
             const std::string& full) {
   if (i + 1 == path.size()) {
     table->insert_or_assign(path[i], value);
+    if (const char* other = AlternativeKey(path[i])) table->erase(other);
     return;
   }
   toml::node* child = table->get(path[i]);
@@ -401,11 +532,22 @@ Config LoadConfig(const std::string& path, const std::vector<std::string>& overr
   return ParseConfig(text.str(), path, overrides);
 }
 
+std::vector<ConfigKey> ListConfigKeys() {
+  Config defaults;
+  std::vector<ConfigKey> keys;
+  VisitSections(defaults, [&](const char* name, auto& section) {
+    KeyLister lister(name, &keys);
+    VisitFields(section, lister);
+  });
+  RodConfig rod;
+  KeyLister lister("rods", &keys);
+  VisitFields(rod, lister);
+  return keys;
+}
+
 std::string ConfigToToml(const Config& config) {
   Config copy = config;
-  std::stringstream out;
-  out << ToTable(copy);
-  return out.str();
+  return TomlText(copy);
 }
 
 std::string ConfigToJson(const Config& config) {

@@ -124,6 +124,14 @@ Config LoadConfig(const std::string& path, const std::vector<std::string>& overr
 Config ParseConfig(const std::string& toml_text, const std::string& file,
                    const std::vector<std::string>& overrides = {});
 
+/// One configuration key: dotted path ("run.time_step", "rods.radius", "rods.loads[].node"),
+/// its TOML type and its default as TOML text ("" when unset by default).
+struct ConfigKey {
+  std::string key, type, default_value;
+};
+/// Every key in the order of the field lists (the reader's); docs/config_keys.md is made from it.
+std::vector<ConfigKey> ListConfigKeys();
+
 /// The resolved configuration (every default filled in) as TOML text / as JSON text.
 std::string ConfigToToml(const Config& config);
 std::string ConfigToJson(const Config& config);
