@@ -19,6 +19,7 @@ struct RunPlan {
   double checkpoint_interval = 0.0;  ///< [s]
   double checkpoint_wall_interval = 0.0;  ///< [s] of wall time (0: every checkpoint_interval)
   bool frames = true;
+  bool binary_frames = false;        ///< run.frames_format = "binary"
   // The same in steps of time_step (dynamic runs).
   long total_steps = 0;
   long output_every = 1;

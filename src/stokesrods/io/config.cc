@@ -29,6 +29,7 @@ void VisitFields(RunConfig& c, V& v) {
   v("integrator", c.integrator);
   v("output_interval", c.output_interval);
   v("frames", c.frames);
+  v("frames_format", c.frames_format);
   v("checkpoint_interval", c.checkpoint_interval);
   v("checkpoint_wall_interval", c.checkpoint_wall_interval);
 }

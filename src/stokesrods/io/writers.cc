@@ -1,11 +1,16 @@
 #include "stokesrods/io/writers.h"
 
+#include <algorithm>
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 
 #include <fmt/format.h>
+
+#include "stokesrods/io/vtk_arrays.h"
+#include "stokesrods/rod/frames.h"
 
 namespace stokesrods {
 
@@ -89,8 +94,9 @@ void TruncateCsv(const std::string& path, long rows) {
   WriteFileAtomically(path, text);
 }
 
-FrameWriter::FrameWriter(const std::string& output_dir, long keep)
+FrameWriter::FrameWriter(const std::string& output_dir, long keep, bool binary)
     : dir_(output_dir),
+      binary_(binary),
       entries_(LeadingLines((fs::path(output_dir) / "rods.pvd").string(), "<DataSet ", keep)) {
   std::error_code ec;
   fs::create_directories(fs::path(dir_) / "frames", ec);
@@ -100,34 +106,41 @@ FrameWriter::FrameWriter(const std::string& output_dir, long keep)
 void FrameWriter::Write(const Model& model, const State& state,
                         const std::vector<FramePointData>& data) {
   const std::string name = fmt::format("frames/rods_{:05d}.vtp", entries_.size());
-  std::string xml;
-  xml += "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n<PolyData>\n";
-  xml += fmt::format("<Piece NumberOfPoints=\"{}\" NumberOfLines=\"{}\">\n", model.num_nodes,
-                     model.rods.size());
-  xml += "<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-  for (const RodModel& rod : model.rods)
+  const std::size_t m = static_cast<std::size_t>(model.num_nodes);
+  std::vector<double> points, radius, d1, d2;
+  std::vector<std::int32_t> connectivity, offsets, rod_id;
+  for (std::size_t r = 0; r < model.rods.size(); ++r) {
+    const RodModel& rod = model.rods[r];
     for (int i = 0; i < rod.num_nodes(); ++i) {
       const Vec3 x = state.q.segment<3>(rod.dof_offset + NodeDof(i));
-      xml += fmt::format("{:.10g} {:.10g} {:.10g}\n", x.x(), x.y(), x.z());
+      points.insert(points.end(), {x.x(), x.y(), x.z()});
+      // The material frame of the edge after the node (the last node: of the last edge).
+      const int edge = std::min(i, rod.num_nodes() - 2);
+      Vec3 m1, m2;
+      MaterialFrame(state.rods[r].frames[edge], state.q(rod.dof_offset + TwistDof(edge)), &m1, &m2);
+      d1.insert(d1.end(), {m1.x(), m1.y(), m1.z()});
+      d2.insert(d2.end(), {m2.x(), m2.y(), m2.z()});
+      radius.push_back(rod.radius);
+      connectivity.push_back(rod.node_offset + i);
+      rod_id.push_back(static_cast<std::int32_t>(r + 1));
     }
-  xml += "</DataArray></Points>\n<Lines>\n<DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">\n";
-  for (const RodModel& rod : model.rods) {
-    for (int i = 0; i < rod.num_nodes(); ++i) xml += fmt::format("{} ", rod.node_offset + i);
-    xml += "\n";
+    offsets.push_back(rod.node_offset + rod.num_nodes());
   }
-  xml += "</DataArray>\n<DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">\n";
-  for (const RodModel& rod : model.rods) xml += fmt::format("{} ", rod.node_offset + rod.num_nodes());
-  xml += "\n</DataArray>\n</Lines>\n<PointData>\n<DataArray type=\"Int32\" Name=\"rod\" format=\"ascii\">\n";
-  for (std::size_t r = 0; r < model.rods.size(); ++r)
-    for (int i = 0; i < model.rods[r].num_nodes(); ++i) xml += fmt::format("{} ", r + 1);
-  xml += "\n</DataArray>\n";
+  std::string xml = fmt::format(
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" "
+      "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<PolyData>\n"
+      "<Piece NumberOfPoints=\"{}\" NumberOfLines=\"{}\">\n<Points>\n",
+      m, model.rods.size());
+  xml += VtkDataArray("points", points, 3, binary_, 10) + "</Points>\n<Lines>\n";
+  xml += VtkDataArray("connectivity", connectivity, 1, binary_);
+  xml += VtkDataArray("offsets", offsets, 1, binary_) + "</Lines>\n";
+  xml += "<PointData Scalars=\"radius\">\n" + VtkDataArray("rod", rod_id, 1, binary_);
+  xml += VtkDataArray("radius", radius, 1, binary_, 10);
+  xml += VtkDataArray("material_d1", d1, 3, binary_, 8) + VtkDataArray("material_d2", d2, 3, binary_, 8);
   for (const FramePointData& d : data) {
-    if (d.values == nullptr || d.values->size() != 3 * model.num_nodes) continue;
-    xml += fmt::format("<DataArray type=\"Float64\" Name=\"{}\" NumberOfComponents=\"3\" format=\"ascii\">\n", d.name);
-    for (int k = 0; k < model.num_nodes; ++k)
-      xml += fmt::format("{:.8g} {:.8g} {:.8g}\n", (*d.values)(3 * k), (*d.values)(3 * k + 1),
-                         (*d.values)(3 * k + 2));
-    xml += "</DataArray>\n";
+    if (d.values == nullptr || static_cast<std::size_t>(d.values->size()) != 3 * m) continue;
+    xml += VtkDataArray(d.name, std::vector<double>(d.values->data(), d.values->data() + 3 * m), 3,
+                        binary_, 8);
   }
   xml += "</PointData>\n</Piece>\n</PolyData>\n</VTKFile>\n";
   WriteFileAtomically((fs::path(dir_) / name).string(), xml);
