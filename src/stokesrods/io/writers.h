@@ -44,7 +44,7 @@ class FrameWriter {
  public:
   /// `keep`: frames of an earlier run kept (--resume): the first `keep` entries of its rods.pvd,
   /// which must have them; the next frame is number `keep`.
-  /// `binary`: base64 arrays (exact, about half the size and much faster to write and read).
+  /// `binary`: base64 arrays (exact doubles, faster to read; about the size of the ASCII).
   explicit FrameWriter(const std::string& output_dir, long keep = 0, bool binary = false);
   void Write(const Model& model, const State& state, const std::vector<FramePointData>& data);
 
