@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -122,6 +124,37 @@ TEST(Cli, NumericalFailureIsExitThreeWithTheLastGoodStateSaved) {
   const nlohmann::json summary = nlohmann::json::parse(Read(out / "summary.json"));
   EXPECT_EQ(summary["status"], "failed");
   EXPECT_TRUE(fs::exists(out / "checkpoint.bin"));
+}
+
+TEST(Cli, AFailedStepSaysWhenWhereAndWhatAndIsHalvedWhenAllowed) {
+  // A loaded straight rod, steps of 0.25 s and at most 10 Newton iterations: the first step
+  // fails; halved down to 1/16 of h where needed, every step converges.
+  const fs::path cfg = WriteConfig(
+      "halve.toml", "[run]\nduration = 1.0\ntime_step = 0.25\n[fluid]\nmodel = \"none\"\n"
+                    "[solver]\nnewton_max_iterations = 10\ndamping = 1.0\n[[rods]]\n"
+                    "shape = \"straight\"\nnodes = 21\nloads = [{node = 20, force = [1e-3, 0.0, 0.0]}]\n");
+  const fs::path out = fs::temp_directory_path() / "stokesrods_cli_halve";
+  fs::remove_all(out);
+  const Outcome failed = RunCli("run " + cfg.string() + " --output " + out.string());
+  EXPECT_EQ(failed.code, 3);
+  for (const char* part : {"Newton did not converge at t = 0.25 s", "after 10 iterations",
+                           "largest at rod 1, node 20 (a force)", "try a smaller run.time_step",
+                           "solver.max_step_halvings", "checkpoint.bin and the last frame"})
+    EXPECT_NE(failed.err.find(part), std::string::npos) << part << "\n" << failed.err;
+  EXPECT_TRUE(fs::exists(out / "frames" / "rods_00001.vtp"));  // the last good state (t = 0)
+  EXPECT_EQ(nlohmann::json::parse(Read(out / "summary.json"))["step_reductions"], 0);
+
+  fs::remove_all(out);
+  const Outcome halved = RunCli("run " + cfg.string() + " --output " + out.string() +
+                                " --set solver.max_step_halvings=4");
+  ASSERT_EQ(halved.code, 0) << halved.err;
+  const nlohmann::json summary = nlohmann::json::parse(Read(out / "summary.json"));
+  EXPECT_GE(summary["step_reductions"].get<long>(), 1);
+  EXPECT_EQ(summary["steps"], 4);
+  std::istringstream csv(Read(out / "timeseries.csv"));
+  std::vector<std::string> times;
+  for (std::string line; std::getline(csv, line);) times.push_back(line.substr(0, line.find(',')));
+  EXPECT_EQ(times, (std::vector<std::string>{"time", "0", "0.25", "0.5", "0.75", "1"}));
 }
 
 TEST(Cli, InterruptFlushesWritesACheckpointAndExits130) {

@@ -318,6 +318,7 @@ RunPlan MakeRunPlan(const Config& config, const Model& model) {
                                  ? *config.run.checkpoint_interval
                                  : std::max(plan.time_step, plan.duration / 10.0);
   plan.checkpoint_wall_interval = config.run.checkpoint_wall_interval.value_or(0.0);
+  plan.max_step_halvings = config.solver.max_step_halvings;
   if (!plan.static_mode) SetStepCounts(config, &plan);
   return plan;
 }

@@ -18,6 +18,7 @@ struct RunPlan {
   double output_interval = 0.0;      ///< [s]
   double checkpoint_interval = 0.0;  ///< [s]
   double checkpoint_wall_interval = 0.0;  ///< [s] of wall time (0: every checkpoint_interval)
+  int max_step_halvings = 0;         ///< a failed step is retried as two of h/2, this deep
   bool frames = true;
   bool binary_frames = false;        ///< run.frames_format = "binary"
   // The same in steps of time_step (dynamic runs).

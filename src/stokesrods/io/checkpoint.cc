@@ -111,6 +111,7 @@ void SaveCheckpoint(const std::string& path, const Model& model, const Checkpoin
   w.Vector(c.history.hydro_force);
   w.Put(static_cast<std::int64_t>(c.counters.newton_iterations));
   w.Put(c.counters.max_penetration);
+  w.Put(static_cast<std::int64_t>(c.counters.step_reductions));
   w.Put(Fnv1a(w.text().data(), w.text().size()));
   WriteFileAtomically(path, w.text());
 }
@@ -162,6 +163,7 @@ Checkpoint LoadCheckpoint(const std::string& path, const Model& model) {
   c.history.hydro_force = r.Vector(3 * model.num_nodes, "the drag", true);
   c.counters.newton_iterations = static_cast<long>(r.Get<std::int64_t>());
   c.counters.max_penetration = r.Get<double>();
+  c.counters.step_reductions = static_cast<long>(r.Get<std::int64_t>());
   if (r.at() + sizeof stored_sum != text.size()) r.Fail("unexpected data after the contents");
   return c;
 }

@@ -24,6 +24,7 @@ namespace stokesrods {
 struct RunCounters {
   long newton_iterations = 0;
   double max_penetration = 0.0;  ///< [m]
+  long step_reductions = 0;      ///< steps retried at h/2
 };
 
 struct Checkpoint {

@@ -61,6 +61,7 @@ void VisitFields(SolverConfig& c, V& v) {
   v("newton_max_iterations", c.newton_max_iterations);
   v("jacobian_max_age", c.jacobian_max_age);
   v("damping", c.damping);
+  v("max_step_halvings", c.max_step_halvings);
 }
 template <class V>
 void VisitFields(FlowFieldConfig& c, V& v) {

@@ -70,6 +70,7 @@ struct SolverConfig {
   int newton_max_iterations = 30;
   int jacobian_max_age = 1;         ///< steps a factorized banded Newton matrix may be reused
   double damping = 0.0;             ///< isotropic viscous damping per unit length [Pa·s]
+  int max_step_halvings = 0;        ///< a failed step is retried as two of h/2, this deep
 };
 
 /// The fluid velocity on a plane grid at chosen times (paper Fig. 6b).

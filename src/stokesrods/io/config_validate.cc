@@ -138,6 +138,7 @@ void ValidateConfig(Config* config) {
   c.Range("solver.newton_max_iterations", config->solver.newton_max_iterations, 1, 10000);
   c.Range("solver.jacobian_max_age", config->solver.jacobian_max_age, 0, 1000000);
   c.NonNegative("solver.damping", config->solver.damping);
+  c.Range("solver.max_step_halvings", config->solver.max_step_halvings, 0, 20);
 
   const FlowFieldConfig& flow = config->flow_field;
   for (std::size_t i = 0; i < flow.times.size(); ++i)

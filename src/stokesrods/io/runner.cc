@@ -105,6 +105,31 @@ struct Schedule {
   }
 };
 
+// One step of h; when it fails, retried as two steps of h/2, each again up to `halvings` deep
+// (solver.max_step_halvings; the driver's policy on failure). The state then reads as one step
+// of h; the next step, at h again, starts as implicit Euler. On failure the state and the
+// history are those before the step (the last good state).
+StepReport StepWithHalving(const Model& model, double h, int halvings, State* state,
+                           Workspace* ws, long* reductions) {
+  StepReport report = Step(model, h, state, ws);
+  if (report.ok || halvings == 0) return report;
+  const State before = *state;
+  const StepHistory history = CaptureHistory(*ws);
+  ++*reductions;
+  StepReport half = StepWithHalving(model, 0.5 * h, halvings - 1, state, ws, reductions);
+  const int first_iterations = half.newton_iterations;
+  if (half.ok) half = StepWithHalving(model, 0.5 * h, halvings - 1, state, ws, reductions);
+  half.newton_iterations += first_iterations + report.newton_iterations;
+  if (!half.ok) {
+    *state = before;
+    RestoreHistory(history, ws);
+    return half;
+  }
+  state->step = before.step + 1;
+  state->time = before.time + h;
+  return half;
+}
+
 // Resume: the checkpoint into the state, the workspace and the counters; returns the rows kept.
 long Resume(const Config& config, const Model& model, const RunPlan& plan,
             const std::string& path, State* state, Workspace* ws, RunCounters* counters) {
@@ -203,7 +228,8 @@ RunResult RunCase(const Config& config, const RunOptions& options) {
       result.message = fmt::format("interrupted at t = {:.6g} s", state.time);
       break;
     }
-    report = sim.Step();
+    report = StepWithHalving(model, h, plan.max_step_halvings, &state, &ws,
+                             &counters.step_reductions);
     counters.newton_iterations += report.newton_iterations;
     if (!report.ok) {
       result.status = RunStatus::kFailed;
@@ -235,6 +261,7 @@ RunResult RunCase(const Config& config, const RunOptions& options) {
   // resumed from it continues exactly); its final state is in the last row and frame.
   result.steps = state.step;
   result.newton_iterations = counters.newton_iterations;
+  result.step_reductions = counters.step_reductions;
   result.wall_seconds = wall();
   if (options.progress) options.progress({state.time, plan.duration, result.wall_seconds, state.step});
   observer.WriteSummary(result.status, result.message, result, counters.max_penetration);

@@ -86,6 +86,26 @@ double RoundOffFloor(const Model& model, const VecX& q) {
   return floor;
 }
 
+// Where a residual is largest, or first not finite: "largest at rod 2, node 14 (a force)".
+std::string DescribeResidual(const Model& model, const VecX& r) {
+  std::size_t worst_rod = 0;
+  int worst_dof = 0;
+  double worst = -1.0;
+  for (std::size_t i = 0; i < model.rods.size() && std::isfinite(worst); ++i) {
+    const RodModel& rod = model.rods[i];
+    for (int k = 0; k < rod.num_dofs(); ++k) {
+      const double w = (k % 4 == 3) ? 1.0 / rod.rest_edge_length(k / 4) : 1.0;
+      const double v = w * std::abs(r(rod.dof_offset + k));
+      if (v > worst || !std::isfinite(v)) worst = v, worst_rod = i, worst_dof = k;
+      if (!std::isfinite(v)) break;
+    }
+  }
+  const bool twist = worst_dof % 4 == 3;
+  return fmt::format("{} at rod {}, {} {} ({})",
+                     std::isfinite(worst) ? "largest" : "not a number or infinite", worst_rod + 1,
+                     twist ? "edge" : "node", worst_dof / 4, twist ? "a twist moment" : "a force");
+}
+
 }  // namespace
 
 void Evaluate(const Model& model, const State& start, double h, const VecX& q,
@@ -336,8 +356,10 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
     if (!newton.converged) {
       report.message = fmt::format(
           "Newton did not converge at t = {:.6g} s: residual {:.3e} N > tolerance {:.3e} N after "
-          "{} iterations",
-          state->time + h, newton.residual, newton.tolerance, newton.iterations);
+          "{} iterations, {}; try a smaller run.time_step, or solver.max_step_halvings to halve "
+          "the steps that fail",
+          state->time + h, newton.residual, newton.tolerance, newton.iterations,
+          DescribeResidual(model, ws->residual));
       if (ws->nonlocal_fluid && !ws->hydro.worst_solve().ok)
         report.message += fmt::format(
             "; a GMRES solve of the drag stopped at a relative residual of {:.1e} after {} "
@@ -363,7 +385,8 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
     if (report.contact_rounds >= model.newton.max_contact_rounds) {
       report.message = fmt::format(
           "contact not resolved at t = {:.6g} s: {} pairs still closer than the contact distance "
-          "after {} rounds (largest penetration {:.3e} m)",
+          "after {} rounds (largest penetration {:.3e} m); try a smaller run.time_step, a larger "
+          "contact.max_rounds, or solver.max_step_halvings",
           state->time + h, report.contact.active, report.contact_rounds,
           report.contact.max_penetration);
       return report;
