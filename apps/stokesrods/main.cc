@@ -128,6 +128,10 @@ int main(int argc, char** argv) {
   } catch (const stokesrods::IoError& e) {
     fmt::print(stderr, "error: input/output: {}\n", e.what());
     return 4;
+  } catch (const std::exception& e) {  // a bug: say so instead of aborting with a trace
+    fmt::print(stderr, "error: internal error: {} (a bug in stokesrods: please report it with the "
+                       "configuration)\n", e.what());
+    return 1;
   }
   return 0;
 }

@@ -111,6 +111,17 @@ TEST(BadInput, RodsOverlappingThemselvesAtTheStartAreRefused) {
   });
 }
 
+TEST(BadInput, OverridesOfRodsThatDoNotExistAreRefused) {
+  const std::string text = std::string(kRun) + kRod;
+  // Found by the fuzzer's first look at --set: a rod number past unsigned long threw
+  // std::out_of_range (an abort in the command line).
+  EXPECT_NE(ErrorOf(text, {"rods.99999999999999999999999.radius=1"})
+                .find("rods.99999999999999999999999.radius: rod 99999999999999999999999 does not exist"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf(text, {"rods.0.radius=1"}).find("rod 0 does not exist (there are 1)"),
+            std::string::npos);
+}
+
 TEST(BadInput, TomlSyntaxErrorsGiveLineAndColumn) {
   ExpectErrors({
       {"[run]\nduration = 1.0\ntime_step = 0.01\n[[rods]]\nnodes = = 3\n", "case.toml: line 5, column"},

@@ -108,6 +108,11 @@ TEST(Cli, UnwritableOutputIsExitFour) {
                                    "[run]\nmode = \"static\"\noutput = \"/proc/stokesrods/x\"\n"
                                    "[fluid]\nmodel = \"none\"\n[[rods]]\nshape = \"straight\"\n");
   EXPECT_EQ(RunCli("run " + cfg.string()).code, 4);
+  // The output directory is an existing file.
+  const fs::path file = WriteConfig("not_a_directory", "x");
+  const Outcome o = RunCli("run " + cfg.string() + " --output " + file.string());
+  EXPECT_EQ(o.code, 4);
+  EXPECT_NE(o.err.find("not_a_directory"), std::string::npos) << o.err;
 }
 
 TEST(Cli, NumericalFailureIsExitThreeWithTheLastGoodStateSaved) {

@@ -469,9 +469,11 @@ void ApplyOverride(toml::table* root, const std::string& assignment, const std::
   if (rods == nullptr || path.size() < 2) throw ConfigError(file, key, "no [[rods]] to set");
   const bool indexed = !path[1].empty() && path[1].find_first_not_of("0123456789") == std::string::npos;
   if (indexed) {
-    const std::size_t k = std::stoul(path[1]);
+    // More digits than any rod count: out of range without overflowing the conversion.
+    const std::size_t k = path[1].size() > 9 ? std::size_t(-1) : std::stoul(path[1]);
     if (k < 1 || k > rods->size())
-      throw ConfigError(file, key, fmt::format("rod {} does not exist (there are {})", k, rods->size()));
+      throw ConfigError(file, key, fmt::format("rod {} does not exist (there are {})", path[1],
+                                               rods->size()));
     path.erase(path.begin(), path.begin() + 2);
     if (path.empty()) throw ConfigError(file, key, "--set needs a key after the rod number");
     SetKey(rods->get(k - 1)->as_table(), path, 0, value, file, key);
