@@ -47,17 +47,33 @@ FluidModel ParseFluidModel(const std::string& name) {
 }
 
 // RFT coefficients, the LSBT discretization, the stability of the explicit coupling.
-// The node count nearest to `estimate` whose rest shape fits LSBT (at most `allowed` edges off),
-// searched outward from it: the helix's spacing depends on N through its lead-in, so the arc
-// length over Δ alone can miss. 0 if none within 200 of the estimate fits.
+// A node count whose rest shape fits LSBT (at most `allowed` edges off), or 0. The helix's
+// spacing depends on N through its lead-in, so the arc length over 2δ alone can miss; the edges
+// shrink as N grows, so a bisection finds the first N whose last edge is no longer than 2δ, and
+// the counts around it are checked in full (about 20 shapes built, whatever the size).
 int FittingLsbtNodes(RodConfig rc, int estimate, int allowed) {
+  const double target = LsbtEdgeLength(rc.radius);
+  auto last_edge = [&](int n) {
+    rc.nodes = n;
+    const Matrix3X x = RestShape(rc);
+    return (x.col(n - 1) - x.col(n - 2)).norm();
+  };
   const int fewest = rc.shape == "helix" ? 5 : 3;
-  for (int offset = 0; offset <= 200; ++offset)
-    for (int n : {estimate - offset, estimate + offset}) {
-      if (n < fewest) continue;
-      rc.nodes = n;
-      if (CheckLsbtDiscretization(RestShape(rc), rc.radius).edges_outside <= allowed) return n;
-    }
+  int lo = fewest;
+  int hi = std::min(1000000, std::max(64, 4 * estimate));
+  if (last_edge(hi) > target) return 0;
+  while (lo < hi) {
+    const int mid = lo + (hi - lo) / 2;
+    if (last_edge(mid) <= target)
+      hi = mid;
+    else
+      lo = mid + 1;
+  }
+  for (int n : {lo, lo - 1, lo + 1, lo - 2, lo + 2}) {
+    if (n < fewest) continue;
+    rc.nodes = n;
+    if (CheckLsbtDiscretization(RestShape(rc), rc.radius).edges_outside <= allowed) return n;
+  }
   return 0;
 }
 
