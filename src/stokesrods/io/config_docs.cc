@@ -43,6 +43,7 @@ const std::map<std::string, std::string>& Meanings() {
       {"solver.newton_tolerance", "Newton residual (a force) relative to max(EI/L², applied forces)"},
       {"solver.newton_max_iterations", "per solve; more is a numerical failure (exit 3)"},
       {"solver.jacobian_max_age", "steps a factorized Newton matrix may be reused (1: a new one every step)"},
+      {"solver.max_step_halvings", "a failed step is retried as two of h/2, this many times deep (0: a failure ends the run; counted in summary.json step_reductions)"},
       {"solver.damping", "isotropic viscous drag per unit length [Pa·s] (validation cases with fluid.model = \"none\")"},
       {"flow_field.times", "simulated times [s] at which the flow on the plane is written (paper Fig. 6b); empty: none"},
       {"flow_field.origin", "a corner of the plane [m]"},
