@@ -4,7 +4,7 @@ set -euo pipefail
 packages=(g++ cmake make libeigen3-dev libtomlplusplus-dev libcli11-dev libfmt-dev nlohmann-json3-dev
           libopenblas-dev liblapack-dev libgtest-dev libbenchmark-dev python3 python3-numpy
           python3-matplotlib python3-dev pybind11-dev python3-pybind11 python3-pytest ffmpeg
-          clang-14 libclang-rt-14-dev)
+          clang-14 libclang-rt-14-dev libopenmpi-dev openmpi-bin)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -15,6 +15,8 @@
 #include "stokesrods/io/runner.h"
 #include "stokesrods/io/writers.h"
 #include "python_tools.h"
+#include "analyze_command.h"
+#include "sweep_command.h"
 
 namespace {
 
@@ -76,6 +78,26 @@ int main(int argc, char** argv) {
       "{views.png,run.mp4,flow.png}");
   CLI::App* plot = stokesrods::AddPythonTool(
       &app, "plot", "time series of a run: RUN_DIR COLUMN... [--x time|t_bar] [--output FILE]");
+  stokesrods::SweepCommandOptions sweep_options;
+  CLI::App* sweep = app.add_subcommand(
+      "sweep", "a parameter sweep: one run per case, --jobs at a time; under mpirun also on the other ranks");
+  sweep->add_option("sweep", sweep_options.file, "sweep file (TOML)")->required();
+  sweep->add_option("--jobs", sweep_options.jobs, "cases at a time on this machine (rank 0 under MPI)")
+      ->check(CLI::PositiveNumber);
+  sweep->add_option("--threads", sweep_options.threads, "OMP_NUM_THREADS of each case (default 1)")
+      ->check(CLI::PositiveNumber);
+  sweep->add_option("--output", sweep_options.output, "the sweep's folder (overrides `output`)");
+  sweep->add_flag("--retry-failed", sweep_options.retry_failed, "rerun cases that failed numerically");
+
+  stokesrods::AnalyzeOptions analyze_options;
+  CLI::App* analyze = app.add_subcommand(
+      "analyze", "derived results of a run or a sweep: crossing time, critical speeds, F̄p");
+  analyze->add_option("dir", analyze_options.dir, "a run's or a sweep's output folder")->required();
+  analyze->add_option("--line", analyze_options.line, "sweep key along which to find the critical value");
+  analyze->add_option("--criterion", analyze_options.criterion, "crossed | buckled")
+      ->check(CLI::IsMember({"crossed", "buckled"}));
+  analyze->add_option("--single", analyze_options.single,
+                      "a run or sweep of one flagellum: F̄p relative to it at the same omega_bar");
 
   try {
     app.parse(argc, argv);
@@ -87,6 +109,13 @@ int main(int argc, char** argv) {
   if (*render) return stokesrods::RunPythonTool("render", render->remaining());
   if (*plot) return stokesrods::RunPythonTool("plot", plot->remaining());
   try {
+    if (*analyze) return stokesrods::RunAnalyzeCommand(analyze_options);
+    if (*sweep) {
+      std::signal(SIGINT, OnSignal);
+      std::signal(SIGTERM, OnSignal);
+      sweep_options.interrupted = [] { return g_interrupted != 0; };
+      return stokesrods::RunSweepCommand(sweep_options);
+    }
     if (!output.empty()) overrides.push_back("run.output=\"" + output + "\"");
     const stokesrods::Config config = stokesrods::LoadConfig(config_path, overrides);
     if (*show) {

@@ -48,3 +48,42 @@ def timeseries(out):
 
 def log(*args):
     print(*args, flush=True, file=sys.stderr)
+
+
+def run_sweep(sweep_file, jobs=JOBS, extra=()):
+    """Runs `stokesrods sweep` (finished cases are skipped) and returns its exit code."""
+    args = [BIN, "sweep", os.path.join(ROOT, sweep_file), "--jobs", str(jobs), *extra]
+    log(" ".join(args))
+    return subprocess.run(args, cwd=ROOT).returncode
+
+
+def analyze(sweep_dir, *extra):
+    """`stokesrods analyze` on a sweep folder; returns (analysis rows, critical rows) as dicts."""
+    subprocess.run([BIN, "analyze", sweep_dir, *extra], cwd=ROOT, check=True, stdout=subprocess.DEVNULL)
+    return read_csv(os.path.join(sweep_dir, "analysis.csv")), read_csv(os.path.join(sweep_dir, "critical.csv"))
+
+
+def read_csv(path):
+    """A CSV file as a list of dicts (strings)."""
+    import csv
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def first_number(text):
+    """The first number of a TOML value's text: "[0.04, 0.0, 0.0]" -> 0.04."""
+    return float(text.strip("[] ").split(",")[0])
+
+
+def sweep_study_main(sweep_files, plot):
+    """Command line of a sweep study: `run` runs the sweeps (resuming) then plots; `plot` plots."""
+    import argparse
+    p = argparse.ArgumentParser()
+    p.add_argument("what", choices=["run", "plot"])
+    p.add_argument("--jobs", type=int, default=2)
+    args = p.parse_args()
+    os.makedirs(os.path.join(ROOT, "docs", "validation"), exist_ok=True)
+    if args.what == "run":
+        for sweep_file in sweep_files:
+            run_sweep(sweep_file, args.jobs)
+    plot()

@@ -37,6 +37,28 @@ TEST(HelixNodes, MatchesTheSpecGeometry) {
   EXPECT_NEAR(arc, 0.3165, 5e-4);
 }
 
+TEST(HelixNodes, LeadInAboveMakesTheHelicalPartSpanL0) {
+  HelixGeometry g;
+  g.lead_in_above = true;
+  const Matrix3X x = HelixNodes(g);
+  const double c = std::sqrt(1.0 + std::pow(2.0 * kPi * 0.01 / 0.05, 2));
+  const double ds = 0.2 * c / 62;  // 62 helical edges over l0 = 0.2 m of axial drop
+  EXPECT_NEAR((x.col(1) - x.col(0)).norm(), ds, 1e-14);
+  EXPECT_TRUE((x.col(2) - x.col(1)).isApprox(Vec3(0.01, 0.0, -0.01), 1e-14));
+  EXPECT_NEAR(x(2, 2) - x(2, 64), 0.2, 1e-14);  // the helical part spans l0
+  EXPECT_NEAR(x(2, 64), -(ds + 0.01 + 0.2), 1e-14);
+  for (int i = 2; i < 64; ++i) EXPECT_NEAR((x.col(i + 1) - x.col(i)).norm(), (x.col(3) - x.col(2)).norm(), 1e-12);
+  // The deformable part is longer than with the lead-in within l0 (issue 8: about 8 %).
+  const Matrix3X within = HelixNodes(HelixGeometry{});
+  auto arc = [](const Matrix3X& y) {
+    double s = 0.0;
+    for (int i = 1; i + 1 < y.cols(); ++i) s += (y.col(i + 1) - y.col(i)).norm();
+    return s;
+  };
+  EXPECT_GT(arc(x) / arc(within), 1.05);
+  EXPECT_LT(arc(x) / arc(within), 1.10);
+}
+
 TEST(HelixNodes, HandednessIsGeometric) {
   HelixGeometry g;
   for (int i = 2; i + 3 < 65; ++i) EXPECT_GT(TorsionSign(HelixNodes(g), i), 0.0) << i;

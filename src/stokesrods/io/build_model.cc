@@ -35,6 +35,7 @@ Matrix3X RestShape(const RodConfig& rod) {
   g.pitch = rod.pitch;
   g.helix_radius = rod.helix_radius;
   g.right_handed = rod.handedness == "right";
+  g.lead_in_above = rod.lead_in == "above";
   g.base = rod.base;
   return HelixNodes(g);
 }

@@ -88,6 +88,7 @@ void VisitFields(RodConfig& c, V& v) {
   v("pitch", c.pitch);
   v("helix_radius", c.helix_radius);
   v("handedness", c.handedness);
+  v("lead_in", c.lead_in);
   v("base", c.base);
   v("clamped_nodes", c.clamped_nodes);
   v("omega", c.omega);

@@ -98,6 +98,9 @@ struct RodConfig {
   double pitch = 0.05;          ///< λ [m], helix
   double helix_radius = 0.01;   ///< R [m], helix
   std::string handedness = "right";
+  /// helix: "within" (l0 spans the whole rod, node 0 to the last) | "above" (l0 is the helical
+  /// part below node 2; the clamped edge and the 45° lead-in sit above it)
+  std::string lead_in = "within";
   Vec3 base = Vec3::Zero();     ///< node 0 [m]
   int clamped_nodes = 2;
   std::optional<double> omega;      ///< [rad/s] about +ẑ

@@ -60,6 +60,7 @@ const std::map<std::string, std::string>& Meanings() {
       {"rods.pitch", "λ [m], helix only"},
       {"rods.helix_radius", "R [m], helix only"},
       {"rods.handedness", "\"right\" or \"left\", helix only"},
+      {"rods.lead_in", "helix only: \"within\" (l0 spans the whole rod, SPEC) or \"above\" (the helical part spans l0 below node 2; clamp edge and lead-in above it)"},
       {"rods.base", "position of node 0 [m]"},
       {"rods.clamped_nodes", "0, 1 or 2 leading nodes held fixed (2 also holds the first twist angle)"},
       {"rods.omega", "rotation rate about +z imposed on the first twist angle [rad/s]; or omega_bar, not both"},

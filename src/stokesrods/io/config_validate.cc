@@ -45,6 +45,7 @@ void ValidateRod(const Checker& c, const std::string& p, RodConfig* rod) {
   c.Positive(p + ".density", rod->density);
   c.Finite(p + ".base", rod->base);
   c.OneOf(p + ".handedness", rod->handedness, {"right", "left"});
+  c.OneOf(p + ".lead_in", rod->lead_in, {"within", "above"});
   c.Range(p + ".clamped_nodes", rod->clamped_nodes, 0, 2);
   if (rod->shape == "points") {
     if (rod->points.size() < 3)

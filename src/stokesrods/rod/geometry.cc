@@ -11,8 +11,10 @@ Matrix3X HelixNodes(const HelixGeometry& g) {
   const int n = g.nodes;
   const double R = g.helix_radius;
   const double c = std::sqrt(1.0 + std::pow(2.0 * kPi * R / g.pitch, 2));
-  const double first_edge = (g.axis_length - R) * c / (n - 3 + c);
-  const double helix_drop = g.axis_length - first_edge - R;  // axial extent of x2 … x_{N−1}
+  // a = Δs (the helical arc spacing); Δs = c · helix_drop / (N − 3).
+  const double first_edge = g.lead_in_above ? g.axis_length * c / (n - 3)
+                                            : (g.axis_length - R) * c / (n - 3 + c);
+  const double helix_drop = g.lead_in_above ? g.axis_length : g.axis_length - first_edge - R;
   const double sign = g.right_handed ? -1.0 : 1.0;           // y = ∓R sin φ
   Matrix3X x(3, n);
   x.col(0) = g.base;

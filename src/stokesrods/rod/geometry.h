@@ -12,6 +12,10 @@ struct HelixGeometry {
   double helix_radius = 0.01; ///< R [m]
   bool right_handed = true;   ///< geometric handedness (a right-hand screw)
   Vec3 base = Vec3::Zero();   ///< position of node 0 [m]
+  /// false: l0 spans node 0 to the last node (SPEC). true: the helical part x2 … x_{N−1} spans
+  /// l0 axially and the first edge and the lead-in x1 → x2 sit above it (the last node lies
+  /// a + R + l0 below the base).
+  bool lead_in_above = false;
 };
 
 /// The paper's helix hanging down from `base` (SPEC "Geometry of shape = helix"):

@@ -1,0 +1,398 @@
+#include "stokesrods/io/sweep.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include "stokesrods/io/config.h"
+#include "stokesrods/io/writers.h"
+
+namespace stokesrods {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using KeyValues = std::vector<std::pair<std::string, const toml::node*>>;
+
+// Dotted keys of a table's leaves ("rods.omega_bar" written quoted or as nested tables), in the
+// order they appear in the file (toml++ iterates tables in key order).
+void Flatten(const toml::table& table, const std::string& prefix, KeyValues* out) {
+  for (const auto& [key, node] : table) {
+    const std::string dotted = prefix.empty() ? std::string(key.str()) : prefix + "." + std::string(key.str());
+    if (node.is_table()) {
+      Flatten(*node.as_table(), dotted, out);
+    } else {
+      out->emplace_back(dotted, &node);
+    }
+  }
+  if (!prefix.empty()) return;
+  std::stable_sort(out->begin(), out->end(), [](const auto& a, const auto& b) {
+    const toml::source_position pa = a.second->source().begin, pb = b.second->source().begin;
+    return pa.line != pb.line ? pa.line < pb.line : pa.column < pb.column;
+  });
+}
+
+// A TOML value as the text --set parses back, floats in their shortest exact form: 43, 0.04,
+// "lsbt", [0.04, 0.0, 0.0].
+std::string TomlText(const toml::node& node) {
+  if (const auto* v = node.as_floating_point()) {
+    std::string text = fmt::format("{}", v->get());
+    if (text.find_first_of(".eEn") == std::string::npos) text += ".0";  // stays a float
+    return text;
+  }
+  if (const auto* a = node.as_array()) {
+    std::string text = "[";
+    for (std::size_t i = 0; i < a->size(); ++i) text += (i > 0 ? ", " : "") + TomlText(*a->get(i));
+    return text + "]";
+  }
+  std::stringstream s;
+  node.visit([&](const auto& v) { s << v; });
+  return s.str();
+}
+
+// A folder name from the case's values, keys in sorted order (so the name does not change when
+// the sweep file lists its keys or values in another order): characters other than
+// [A-Za-z0-9._+=-] become '_'.
+std::string FolderName(const std::string& prefix,
+                       std::vector<std::pair<std::string, std::string>> values) {
+  std::sort(values.begin(), values.end());
+  std::string name = prefix;
+  for (const auto& [key, text] : values) {
+    std::string part = key.substr(key.rfind('.') == std::string::npos ? 0 : key.rfind('.') + 1);
+    if (key.rfind("rods.", 0) == 0 && key.size() > 5 && std::isdigit(key[5])) part = "rod" + key.substr(5, key.find('.', 5) - 5) + "." + part;
+    part += "=" + text;
+    if (!name.empty()) name += "__";
+    name += part;
+  }
+  std::string clean;
+  for (char ch : name) {
+    const bool keep = std::isalnum(static_cast<unsigned char>(ch)) || ch == '.' || ch == '_' ||
+                      ch == '-' || ch == '+' || ch == '=';
+    if (!keep && !clean.empty() && clean.back() == '_') continue;
+    clean += keep ? ch : '_';
+  }
+  return clean.empty() ? std::string("case") : clean;
+}
+
+struct CaseSpec {
+  std::string prefix;
+  KeyValues keys;
+};
+
+// The explicit [[cases]] (one empty case when there are none).
+std::vector<CaseSpec> ReadCases(const toml::table& root, const std::string& file) {
+  const toml::node* node = root.get("cases");
+  if (node == nullptr) return {CaseSpec{}};
+  if (!node->is_array_of_tables() || node->as_array()->empty())
+    throw ConfigError(file, "cases", "expected one or more [[cases]] tables");
+  std::vector<CaseSpec> cases;
+  for (const auto& entry : *node->as_array()) {
+    CaseSpec spec;
+    for (const auto& [key, value] : *entry.as_table()) {
+      if (key.str() == "name") {
+        if (!value.is_string()) throw ConfigError(file, "cases.name", "expected a string");
+        spec.prefix = **value.as_string();
+      }
+    }
+    Flatten(*entry.as_table(), "", &spec.keys);
+    std::erase_if(spec.keys, [](const auto& kv) { return kv.first == "name"; });
+    cases.push_back(std::move(spec));
+  }
+  return cases;
+}
+
+std::string Override(const std::string& key, const std::string& text) { return key + "=" + text; }
+
+std::optional<RefineSpec> ReadRefine(const toml::table& root, const Sweep& sweep) {
+  const toml::node* node = root.get("refine");
+  if (node == nullptr) return std::nullopt;
+  const std::string& file = sweep.file;
+  if (!node->is_table()) throw ConfigError(file, "refine", "expected a table");
+  const toml::table& t = *node->as_table();
+  for (const auto& [key, value] : t)
+    if (key.str() != "key" && key.str() != "criterion" && key.str() != "resolution")
+      throw ConfigError(file, "refine." + std::string(key.str()), "unknown key (known: key, criterion, resolution)");
+  RefineSpec spec;
+  spec.key = t["key"].value_or(std::string());
+  if (std::find(sweep.varied_keys.begin(), sweep.varied_keys.end(), spec.key) == sweep.varied_keys.end())
+    throw ConfigError(file, "refine.key", "expected one of the varied keys");
+  spec.criterion = t["criterion"].value_or(std::string());
+  if (spec.criterion != "crossed" && spec.criterion != "buckled")
+    throw ConfigError(file, "refine.criterion", "expected \"crossed\" or \"buckled\"");
+  spec.resolution = t["resolution"].value_or(0.0);
+  if (!(spec.resolution > 0.0)) throw ConfigError(file, "refine.resolution", "expected a number > 0");
+  return spec;
+}
+
+std::string OutputOverride(const std::string& dir) {
+  return "run.output=" + TomlText(toml::value<std::string>(dir));
+}
+
+}  // namespace
+
+Sweep ParseSweep(const std::string& toml_text, const std::string& file, const std::string& dir,
+                 const std::string& output) {
+  toml::table root;
+  try {
+    root = toml::parse(toml_text, file);
+  } catch (const toml::parse_error& e) {
+    throw ConfigError(file, fmt::format("line {}", e.source().begin.line), std::string(e.description()));
+  }
+  static const std::set<std::string> kKeys = {"base", "output", "set", "vary", "cases", "refine"};
+  for (const auto& [key, node] : root)
+    if (kKeys.count(std::string(key.str())) == 0)
+      throw ConfigError(file, std::string(key.str()), "unknown key (known: base, output, set, vary, cases, refine)");
+  Sweep sweep;
+  sweep.file = file;
+  const auto base = root["base"].value<std::string>();
+  if (!base) throw ConfigError(file, "base", "missing or not a string: the configuration to vary");
+  sweep.base = (fs::path(dir) / *base).lexically_normal().string();
+  if (!fs::exists(sweep.base)) throw ConfigError(file, "base", fmt::format("{}: no such file", sweep.base));
+  sweep.output = output.empty() ? root["output"].value_or(std::string()) : output;
+  if (sweep.output.empty()) throw ConfigError(file, "output", "missing or not a string: the sweep's folder");
+
+  KeyValues fixed, varied;
+  for (const char* section : {"set", "vary"}) {
+    const toml::node* node = root.get(section);
+    if (node == nullptr) continue;
+    if (!node->is_table()) throw ConfigError(file, section, "expected a table");
+    Flatten(*node->as_table(), "", section == std::string("set") ? &fixed : &varied);
+  }
+  for (const auto& [key, node] : varied)
+    if (!node->is_array() || node->as_array()->empty())
+      throw ConfigError(file, "vary." + key, "expected a non-empty list of values");
+  const std::vector<CaseSpec> specs = ReadCases(root, file);
+
+  // Column order: the keys of the explicit cases (first seen), then the [vary] keys.
+  for (const CaseSpec& spec : specs)
+    for (const auto& kv : spec.keys)
+      if (std::find(sweep.varied_keys.begin(), sweep.varied_keys.end(), kv.first) == sweep.varied_keys.end())
+        sweep.varied_keys.push_back(kv.first);
+  for (const auto& kv : varied) sweep.varied_keys.push_back(kv.first);
+  for (const auto& [key, node] : fixed) sweep.fixed_overrides.push_back(Override(key, TomlText(*node)));
+  sweep.refine = ReadRefine(root, sweep);
+
+  std::set<std::string> names;
+  for (const CaseSpec& spec : specs) {
+    // Odometer over the [vary] lists, the last key fastest.
+    std::vector<std::size_t> at(varied.size(), 0);
+    for (bool more = true; more;) {
+      std::vector<std::pair<std::string, std::string>> values;
+      for (const auto& [key, node] : spec.keys) values.emplace_back(key, TomlText(*node));
+      for (std::size_t k = 0; k < varied.size(); ++k)
+        values.emplace_back(varied[k].first, TomlText(*varied[k].second->as_array()->get(at[k])));
+      SweepCase c = MakeSweepCase(sweep, spec.prefix, std::move(values));
+      if (!names.insert(c.name).second)
+        throw ConfigError(file, c.name, "two cases have the same values (duplicate case)");
+      sweep.cases.push_back(std::move(c));
+      more = false;
+      for (std::size_t k = varied.size(); k-- > 0;) {
+        if (++at[k] < varied[k].second->as_array()->size()) {
+          more = true;
+          break;
+        }
+        at[k] = 0;
+      }
+    }
+  }
+  for (const SweepCase& c : sweep.cases) {
+    try {
+      LoadConfig(sweep.base, c.overrides);
+    } catch (const ConfigError& e) {
+      throw ConfigError(file, e.key(), fmt::format("case {}: {}", c.name, e.what()));
+    }
+  }
+  return sweep;
+}
+
+SweepCase MakeSweepCase(const Sweep& sweep, const std::string& prefix,
+                        std::vector<std::pair<std::string, std::string>> values) {
+  SweepCase c;
+  c.prefix = prefix;
+  c.overrides = sweep.fixed_overrides;
+  for (const auto& [key, text] : values) c.overrides.push_back(Override(key, text));
+  c.values = std::move(values);
+  c.name = FolderName(prefix, c.values);
+  c.output_dir = (fs::path(sweep.output) / c.name).string();
+  return c;
+}
+
+nlohmann::json CaseToJson(const SweepCase& c) {
+  return {{"prefix", c.prefix}, {"name", c.name}, {"values", c.values},
+          {"overrides", c.overrides}, {"output_dir", c.output_dir}};
+}
+
+SweepCase CaseFromJson(const nlohmann::json& j) {
+  SweepCase c;
+  c.prefix = j.at("prefix").get<std::string>();
+  c.name = j.at("name").get<std::string>();
+  c.values = j.at("values").get<std::vector<std::pair<std::string, std::string>>>();
+  c.overrides = j.at("overrides").get<std::vector<std::string>>();
+  c.output_dir = j.at("output_dir").get<std::string>();
+  return c;
+}
+
+void WriteSweepJson(const Sweep& sweep) {
+  nlohmann::json j = {{"file", sweep.file}, {"base", sweep.base}, {"output", sweep.output},
+                      {"varied_keys", sweep.varied_keys}, {"fixed_overrides", sweep.fixed_overrides}};
+  j["refine"] = sweep.refine ? nlohmann::json{{"key", sweep.refine->key},
+                                              {"criterion", sweep.refine->criterion},
+                                              {"resolution", sweep.refine->resolution}}
+                             : nlohmann::json();
+  j["cases"] = nlohmann::json::array();
+  for (const SweepCase& c : sweep.cases) j["cases"].push_back(CaseToJson(c));
+  std::error_code ec;
+  fs::create_directories(sweep.output, ec);
+  WriteFileAtomically((fs::path(sweep.output) / "sweep.json").string(), j.dump(1) + "\n");
+}
+
+Sweep ReadSweepJson(const std::string& dir) {
+  const fs::path path = fs::path(dir) / "sweep.json";
+  std::ifstream in(path);
+  if (!in) throw IoError(path.string() + ": cannot read (not a sweep's folder?)");
+  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  if (!j.is_object()) throw IoError(path.string() + ": not JSON");
+  Sweep sweep;
+  try {
+    sweep.file = j.at("file").get<std::string>();
+    sweep.base = j.at("base").get<std::string>();
+    sweep.output = dir;
+    sweep.varied_keys = j.at("varied_keys").get<std::vector<std::string>>();
+    sweep.fixed_overrides = j.at("fixed_overrides").get<std::vector<std::string>>();
+    if (!j.at("refine").is_null())
+      sweep.refine = RefineSpec{j["refine"].at("key").get<std::string>(),
+                                j["refine"].at("criterion").get<std::string>(),
+                                j["refine"].at("resolution").get<double>()};
+    for (const nlohmann::json& c : j.at("cases")) {
+      sweep.cases.push_back(CaseFromJson(c));
+      sweep.cases.back().output_dir = (fs::path(dir) / sweep.cases.back().name).string();
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw IoError(fmt::format("{}: {}", path.string(), e.what()));
+  }
+  return sweep;
+}
+
+Sweep LoadSweep(const std::string& path, const std::string& output) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError(path, "", "cannot open the file");
+  std::stringstream text;
+  text << in.rdbuf();
+  return ParseSweep(text.str(), path, fs::path(path).parent_path().string(), output);
+}
+
+std::vector<std::string> CaseArguments(const Sweep& sweep, const SweepCase& c, bool resume) {
+  std::vector<std::string> args = {"run", sweep.base, "--output", c.output_dir};
+  for (const std::string& o : c.overrides) {
+    args.push_back("--set");
+    args.push_back(o);
+  }
+  if (resume) args.push_back("--resume");
+  return args;
+}
+
+CaseRecord MakeCaseRecord(int exit_code, int signal, double wall_seconds,
+                          const std::string& summary_text) {
+  CaseRecord r;
+  r.exit_code = signal != 0 ? 128 + signal : exit_code;
+  r.wall_seconds = wall_seconds;
+  nlohmann::json summary;
+  if (!summary_text.empty()) summary = nlohmann::json::parse(summary_text, nullptr, false);
+  if (summary.is_object()) {
+    r.message = summary.value("message", "");
+    if (summary.contains("final") && summary["final"].is_object()) r.final_values = summary["final"];
+  }
+  if (signal != 0) {
+    r.status = "crashed";
+    r.message = fmt::format("killed by signal {}", signal);
+  } else if (exit_code == 0) {
+    r.status = "completed";
+  } else if (exit_code == 3) {
+    r.status = "failed";
+  } else if (exit_code == 130) {
+    r.status = "interrupted";
+  } else if (exit_code == 2 || exit_code == 4) {
+    r.status = "error";
+    if (r.message.empty()) r.message = fmt::format("exit code {}; see run.log", exit_code);
+  } else {
+    r.status = "crashed";
+    r.message = fmt::format("exit code {}; see run.log", exit_code);
+  }
+  return r;
+}
+
+CaseRecord ReadCaseRecord(const Sweep& sweep, const SweepCase& c) {
+  CaseRecord pending;
+  std::ifstream in(fs::path(c.output_dir) / "summary.json");
+  if (!in) return pending;
+  const nlohmann::json summary = nlohmann::json::parse(in, nullptr, false);
+  if (!summary.is_object() || !summary.contains("config")) return pending;
+  std::vector<std::string> overrides = c.overrides;
+  overrides.push_back(OutputOverride(c.output_dir));
+  const nlohmann::json now = nlohmann::json::parse(ConfigToJson(LoadConfig(sweep.base, overrides)));
+  if (summary["config"] != now) return pending;  // made from another configuration: rerun
+  const std::string status = summary.value("status", "");
+  const int code = status == "completed" ? 0 : status == "failed" ? 3 : 130;
+  CaseRecord r = MakeCaseRecord(code, 0, summary.value("wall_seconds", 0.0), summary.dump());
+  if (status == "interrupted") {
+    r.resumable = fs::exists(fs::path(c.output_dir) / "checkpoint.bin");
+    if (!r.resumable) return pending;
+  }
+  return r;
+}
+
+namespace {
+
+std::string CsvField(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (char ch : text) quoted += ch == '"' ? std::string("\"\"") : std::string(1, ch == '\n' ? ' ' : ch);
+  return quoted + "\"";
+}
+
+std::string CsvNumber(const nlohmann::json& v) {
+  if (v.is_number()) return fmt::format("{:.17g}", v.get<double>());
+  return v.is_null() ? std::string() : CsvField(v.dump());
+}
+
+}  // namespace
+
+void WriteSweepCsv(const Sweep& sweep, const std::vector<CaseRecord>& records) {
+  std::vector<std::string> final_columns;
+  std::set<std::string> seen;
+  for (const CaseRecord& r : records)
+    for (const auto& [key, value] : r.final_values.items())
+      if (seen.insert(key).second) final_columns.push_back(key);
+  std::string text = "case";
+  for (const std::string& k : sweep.varied_keys) text += "," + CsvField(k);
+  text += ",status,exit_code,wall_seconds,rank,message";
+  for (const std::string& k : final_columns) text += "," + CsvField(k);
+  text += "\n";
+  for (std::size_t i = 0; i < sweep.cases.size(); ++i) {
+    const SweepCase& c = sweep.cases[i];
+    const CaseRecord& r = records[i];
+    text += CsvField(c.name);
+    for (const std::string& k : sweep.varied_keys) {
+      std::string value;
+      for (const auto& [key, t] : c.values)
+        if (key == k) value = t;
+      text += "," + CsvField(value);
+    }
+    text += fmt::format(",{},{},{:.3f},{},{}", r.status, r.exit_code, r.wall_seconds, r.rank,
+                        CsvField(r.message));
+    for (const std::string& k : final_columns)
+      text += "," + (r.final_values.contains(k) ? CsvNumber(r.final_values[k]) : std::string());
+    text += "\n";
+  }
+  std::error_code ec;
+  fs::create_directories(sweep.output, ec);
+  WriteFileAtomically((fs::path(sweep.output) / "sweep.csv").string(), text);
+}
+
+}  // namespace stokesrods

@@ -1,0 +1,160 @@
+// `stokesrods sweep` as users run it: cases in separate processes, failure isolation, resume after
+// a finished or an interrupted sweep, bad sweep files, and the same sweep under mpirun -n 2.
+#include <gtest/gtest.h>
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// Tiny cases: 5 steps of an 11-node helix; "solver.newton_max_iterations" = 1 makes one fail.
+const char* kBase =
+    "[run]\nduration = 0.05\ntime_step = 0.01\nframes = false\n[fluid]\nmodel = \"rss\"\n"
+    "[[rods]]\nnodes = 11\nomega_bar = 100\n";
+
+fs::path Dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("stokesrods_sweep_cli." + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "base.toml") << kBase;
+  return dir;
+}
+
+std::string Read(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+struct Outcome {
+  int code = -1;
+  std::string err;
+};
+
+Outcome Shell(const fs::path& dir, const std::string& command) {
+  const fs::path err = dir / "stderr.txt";
+  const int status = std::system((command + " > /dev/null 2> " + err.string() + " < /dev/null").c_str());
+  return {WEXITSTATUS(status), Read(err)};
+}
+
+std::string Sweep(const fs::path& dir) { return std::string(STOKESRODS_BINARY) + " sweep " + dir.string(); }
+
+// sweep.csv as rows of column → value (no quoted commas in the columns read here).
+std::vector<std::map<std::string, std::string>> ReadCsv(const fs::path& path) {
+  std::istringstream in(Read(path));
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> header;
+  std::istringstream h(line);
+  for (std::string f; std::getline(h, f, ',');) header.push_back(f);
+  std::vector<std::map<std::string, std::string>> rows;
+  while (std::getline(in, line)) {
+    std::istringstream r(line);
+    std::map<std::string, std::string> row;
+    std::string f;
+    for (std::size_t i = 0; i < header.size() && std::getline(r, f, ','); ++i) row[header[i]] = f;
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+TEST(SweepCli, AFailingCaseIsRecordedAndTheOthersComplete) {
+  const fs::path dir = Dir("failure");
+  std::ofstream(dir / "s.toml") << "base = \"base.toml\"\noutput = \"" << (dir / "out").string()
+                                << "\"\n[set]\n\"run.time_step\" = 0.025\n[vary]\n"
+                                << "\"solver.newton_max_iterations\" = [1, 30]\n"
+                                << "\"rods.omega_bar\" = [100, 200]\n";
+  const Outcome o = Shell(dir, Sweep(dir / "s.toml") + " --jobs 2");
+  EXPECT_EQ(o.code, 3) << o.err;  // not every case completed
+  const auto rows = ReadCsv(dir / "out" / "sweep.csv");
+  ASSERT_EQ(rows.size(), 4u);
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(rows[i].at("status"), i < 2 ? "failed" : "completed") << rows[i].at("case");
+    EXPECT_EQ(rows[i].at("exit_code"), i < 2 ? "3" : "0");
+  }
+  EXPECT_NE(rows[2].at("rod1_length_bar"), "");
+  EXPECT_EQ(rows[2].at("t_bar").empty(), false);
+  EXPECT_NE(o.err.find("4/4 done (2 failed)"), std::string::npos) << o.err;
+}
+
+TEST(SweepCli, ARerunSkipsFinishedCasesAndRunsTheMissingOnes) {
+  const fs::path dir = Dir("resume");
+  std::ofstream(dir / "s.toml") << "base = \"base.toml\"\noutput = \"out\"\n[vary]\n"
+                                << "\"rods.omega_bar\" = [100, 200, 300]\n";
+  const std::string cmd = "cd " + dir.string() + " && " + Sweep(dir / "s.toml");
+  ASSERT_EQ(Shell(dir, cmd).code, 0);
+  const fs::path kept = dir / "out" / "omega_bar=100" / "summary.json";
+  const auto stamp = fs::last_write_time(kept);
+  fs::remove_all(dir / "out" / "omega_bar=300");
+  const Outcome again = Shell(dir, cmd);
+  ASSERT_EQ(again.code, 0) << again.err;
+  EXPECT_NE(again.err.find("3 cases in out (2 finished before, skipped;"), std::string::npos) << again.err;
+  EXPECT_EQ(fs::last_write_time(kept), stamp);
+  const auto rows = ReadCsv(dir / "out" / "sweep.csv");
+  ASSERT_EQ(rows.size(), 3u);
+  for (const auto& row : rows) EXPECT_EQ(row.at("status"), "completed");
+  // A changed base configuration is not "finished": every case runs again.
+  std::ofstream(dir / "base.toml") << std::string(kBase) << "poisson_ratio = 0.4\n";
+  const Outcome changed = Shell(dir, cmd);
+  EXPECT_NE(changed.err.find("(0 finished before"), std::string::npos) << changed.err;
+}
+
+TEST(SweepCli, AnInterruptedSweepKeepsFinishedCasesAndResumesTheOthers) {
+  const fs::path dir = Dir("interrupt");
+  // One quick case, one that cannot finish within the second before the interrupt.
+  std::ofstream(dir / "s.toml") << "base = \"base.toml\"\noutput = \"" << (dir / "out").string()
+                                << "\"\n[[cases]]\nname = \"quick\"\n[[cases]]\nname = \"long\"\n"
+                                << "\"run.duration\" = 1000.0\n\"run.checkpoint_interval\" = 0.05\n";
+  const Outcome o = Shell(dir, "timeout --preserve-status -s INT 2 " + Sweep(dir / "s.toml") + " --jobs 2");
+  EXPECT_EQ(o.code, 130) << o.err;
+  const auto rows = ReadCsv(dir / "out" / "sweep.csv");
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].at("status"), "completed");
+  EXPECT_EQ(rows[1].at("status"), "interrupted");
+  // The rerun resumes the long case from its checkpoint (it then runs on: stop it again).
+  const Outcome again = Shell(dir, "timeout --preserve-status -s INT 2 " + Sweep(dir / "s.toml"));
+  EXPECT_NE(again.err.find("(1 finished before, skipped; 1 to resume)"), std::string::npos) << again.err;
+}
+
+TEST(SweepCli, BadSweepFileIsExitTwoNamingFileAndKey) {
+  const fs::path dir = Dir("bad");
+  std::ofstream(dir / "s.toml") << "base = \"base.toml\"\noutput = \"out\"\n[vary]\n"
+                                << "\"rods.omega_barr\" = [1, 2]\n";
+  const Outcome o = Shell(dir, Sweep(dir / "s.toml"));
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("s.toml"), std::string::npos) << o.err;
+  EXPECT_NE(o.err.find("omega_barr"), std::string::npos) << o.err;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
+#ifdef STOKESRODS_MPIEXEC
+TEST(SweepCli, UnderMpirunTheCasesAreSpreadOverTheRanks) {
+  const fs::path dir = Dir("mpi");
+  std::ofstream(dir / "s.toml") << "base = \"base.toml\"\noutput = \"" << (dir / "out").string()
+                                << "\"\n[vary]\n\"rods.omega_bar\" = [100, 200, 300, 400]\n";
+  const Outcome o = Shell(dir, std::string(STOKESRODS_MPIEXEC) +
+                                 " -n 2 --allow-run-as-root --oversubscribe " + Sweep(dir / "s.toml"));
+  ASSERT_EQ(o.code, 0) << o.err;
+  const auto rows = ReadCsv(dir / "out" / "sweep.csv");
+  ASSERT_EQ(rows.size(), 4u);
+  std::map<std::string, int> per_rank;
+  for (const auto& row : rows) {
+    EXPECT_EQ(row.at("status"), "completed");
+    ++per_rank[row.at("rank")];
+  }
+  EXPECT_GT(per_rank["0"], 0) << o.err;
+  EXPECT_GT(per_rank["1"], 0) << o.err;
+  EXPECT_EQ(per_rank["0"] + per_rank["1"], 4);
+}
+#endif
+
+}  // namespace

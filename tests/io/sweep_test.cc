@@ -1,0 +1,152 @@
+// The sweep file: expansion into cases, the checks of bad files, and what a rerun skips.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+#include "stokesrods/io/config.h"
+#include "stokesrods/io/sweep.h"
+
+namespace stokesrods {
+namespace {
+
+namespace fs = std::filesystem;
+
+const char* kBase =
+    "[run]\nduration = 0.05\ntime_step = 0.01\nframes = false\n[fluid]\nmodel = \"none\"\n"
+    "[[rods]]\nnodes = 11\nomega_bar = 100\n[[rods]]\nnodes = 11\nbase = [0.04, 0.0, 0.0]\n"
+    "omega_bar = 100\n";
+
+fs::path Dir() {
+  const fs::path dir = fs::temp_directory_path() / ("stokesrods_sweep_test." + std::to_string(getpid()));
+  fs::create_directories(dir);
+  std::ofstream(dir / "base.toml") << kBase;
+  return dir;
+}
+
+Sweep Parse(const std::string& text) {
+  return ParseSweep("base = \"base.toml\"\noutput = \"" + (Dir() / "out").string() + "\"\n" + text,
+                    "s.toml", Dir().string());
+}
+
+std::string ErrorOf(const std::string& text) {
+  try {
+    Parse(text);
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.file(), "s.toml");
+    return e.key() + " | " + e.what();
+  }
+  return "no error";
+}
+
+TEST(Sweep, VaryIsTheCartesianProductWithTheLastKeyFastest) {
+  const Sweep s = Parse("[vary]\n\"rods.omega_bar\" = [43, 107]\n"
+                        "\"rods.2.base\" = [[0.04, 0.0, 0.0], [0.06, 0.0, 0.0], [0.08, 0.0, 0.0]]\n");
+  ASSERT_EQ(s.cases.size(), 6u);
+  EXPECT_EQ(s.varied_keys, (std::vector<std::string>{"rods.omega_bar", "rods.2.base"}));
+  EXPECT_EQ(s.cases[0].values[0].second, "43");
+  EXPECT_EQ(s.cases[1].values[1].second, "[0.06, 0.0, 0.0]");
+  EXPECT_EQ(s.cases[3].values[0].second, "107");
+  EXPECT_EQ(s.cases[3].values[1].second, "[0.04, 0.0, 0.0]");
+  EXPECT_EQ(s.cases[0].name, "rod2.base=_0.04_0.0_0.0___omega_bar=43");  // keys sorted
+  EXPECT_EQ(s.cases[0].output_dir, (Dir() / "out" / s.cases[0].name).string());
+  // The overrides give the configuration the case stands for.
+  const Config c = LoadConfig(s.base, s.cases[5].overrides);
+  EXPECT_DOUBLE_EQ(*c.rods[0].omega_bar, 107.0);
+  EXPECT_DOUBLE_EQ(*c.rods[1].omega_bar, 107.0);
+  EXPECT_DOUBLE_EQ(c.rods[1].base.x(), 0.08);
+  EXPECT_DOUBLE_EQ(c.rods[0].base.x(), 0.0);
+}
+
+TEST(Sweep, FolderNamesDoNotDependOnTheOrderOfKeysOrValues) {
+  const Sweep a = Parse("[vary]\n\"rods.omega_bar\" = [43, 107]\n\"run.time_step\" = [0.01, 0.02]\n");
+  const Sweep b = Parse("[vary]\n\"run.time_step\" = [0.02, 0.01]\n\"rods.omega_bar\" = [107, 43]\n");
+  std::set<std::string> names_a, names_b;
+  for (const SweepCase& c : a.cases) names_a.insert(c.name);
+  for (const SweepCase& c : b.cases) names_b.insert(c.name);
+  EXPECT_EQ(names_a, names_b);
+  EXPECT_EQ(names_a.size(), 4u);
+  EXPECT_EQ(b.cases[0].values[0].first, "run.time_step");  // columns keep the file's order
+}
+
+TEST(Sweep, ExplicitCasesTimesVaryWithFixedSettings) {
+  const Sweep s = Parse("[set]\n\"run.time_step\" = 0.02\nfluid.model = \"rft\"\n"
+                        "[vary]\nrods.omega_bar = [1, 2, 3]\n"
+                        "[[cases]]\nname = \"near\"\n\"rods.2.base\" = [0.04, 0.0, 0.0]\n"
+                        "[[cases]]\nname = \"far\"\n\"rods.2.base\" = [1.0, 0.0, 0.0]\n");
+  ASSERT_EQ(s.cases.size(), 6u);
+  EXPECT_EQ(s.varied_keys, (std::vector<std::string>{"rods.2.base", "rods.omega_bar"}));
+  EXPECT_EQ(s.cases[4].name.rfind("far__", 0), 0u) << s.cases[4].name;
+  const Config c = LoadConfig(s.base, s.cases[4].overrides);
+  EXPECT_DOUBLE_EQ(c.run.time_step, 0.02);
+  EXPECT_EQ(c.fluid.model, "rft");
+  EXPECT_DOUBLE_EQ(c.rods[1].base.x(), 1.0);
+  EXPECT_DOUBLE_EQ(*c.rods[0].omega_bar, 2.0);
+  EXPECT_EQ(Parse("").cases.size(), 1u);  // no vary, no cases: the base alone
+}
+
+TEST(Sweep, BadFilesNameTheKeyAndTheProblem) {
+  EXPECT_NE(ErrorOf("[vary]\n\"rods.omega_bar\" = 5\n").find("vary.rods.omega_bar | "), std::string::npos);
+  EXPECT_NE(ErrorOf("[vary]\n\"rods.omega_bar\" = []\n").find("non-empty list"), std::string::npos);
+  EXPECT_NE(ErrorOf("frobnicate = 1\n").find("frobnicate | "), std::string::npos);
+  const std::string unknown = ErrorOf("[vary]\n\"rods.omega_barr\" = [1]\n");
+  EXPECT_NE(unknown.find("omega_barr"), std::string::npos) << unknown;
+  EXPECT_NE(unknown.find("case omega_barr=1"), std::string::npos) << unknown;
+  EXPECT_NE(ErrorOf("[vary]\n\"rods.3.omega_bar\" = [1]\n").find("rod 3 does not exist"), std::string::npos);
+  EXPECT_NE(ErrorOf("[vary]\n\"rods.nodes\" = [1]\n").find("case nodes=1"), std::string::npos);
+  EXPECT_NE(ErrorOf("[vary]\n\"rods.omega_bar\" = [1, 1]\n").find("duplicate case"), std::string::npos);
+  try {
+    ParseSweep("base = \"missing.toml\"\noutput = \"x\"\n", "s.toml", Dir().string());
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.key(), "base");
+  }
+}
+
+TEST(Sweep, ExitCodesMapToStatuses) {
+  EXPECT_EQ(MakeCaseRecord(0, 0, 1.0, "").status, "completed");
+  EXPECT_EQ(MakeCaseRecord(3, 0, 1.0, "").status, "failed");
+  EXPECT_EQ(MakeCaseRecord(130, 0, 1.0, "").status, "interrupted");
+  EXPECT_EQ(MakeCaseRecord(4, 0, 1.0, "").status, "error");
+  const CaseRecord killed = MakeCaseRecord(0, 11, 1.0, "");
+  EXPECT_EQ(killed.status, "crashed");
+  EXPECT_EQ(killed.exit_code, 139);
+  EXPECT_EQ(MakeCaseRecord(1, 0, 1.0, "").status, "crashed");
+  const CaseRecord r = MakeCaseRecord(0, 0, 2.0, "{\"final\": {\"t_bar\": 0.5}, \"message\": \"\"}");
+  EXPECT_DOUBLE_EQ(r.final_values["t_bar"].get<double>(), 0.5);
+}
+
+TEST(Sweep, ARerunSkipsOnlyCasesMadeFromTheSameConfiguration) {
+  const Sweep s = Parse("[vary]\n\"rods.omega_bar\" = [43, 107]\n");
+  const SweepCase& c = s.cases[0];
+  fs::remove_all(c.output_dir);
+  EXPECT_EQ(ReadCaseRecord(s, c).status, "pending");  // never run
+  fs::create_directories(c.output_dir);
+  std::vector<std::string> overrides = c.overrides;
+  overrides.push_back("run.output=\"" + c.output_dir + "\"");
+  const std::string same = ConfigToJson(LoadConfig(s.base, overrides));
+  const std::string other = ConfigToJson(LoadConfig(s.base, {"rods.omega_bar=44"}));
+  auto write_summary = [&](const std::string& status, const std::string& config) {
+    std::ofstream(fs::path(c.output_dir) / "summary.json")
+        << "{\"status\": \"" << status << "\", \"config\": " << config
+        << ", \"final\": {\"t_bar\": 1.0}, \"wall_seconds\": 3.5}";
+  };
+  write_summary("completed", same);
+  const CaseRecord done = ReadCaseRecord(s, c);
+  EXPECT_EQ(done.status, "completed");
+  EXPECT_DOUBLE_EQ(done.wall_seconds, 3.5);
+  write_summary("failed", same);
+  EXPECT_EQ(ReadCaseRecord(s, c).status, "failed");
+  write_summary("completed", other);
+  EXPECT_EQ(ReadCaseRecord(s, c).status, "pending");
+  write_summary("interrupted", same);
+  EXPECT_EQ(ReadCaseRecord(s, c).status, "pending");  // no checkpoint: start again
+  std::ofstream(fs::path(c.output_dir) / "checkpoint.bin") << "x";
+  EXPECT_TRUE(ReadCaseRecord(s, c).resumable);
+}
+
+}  // namespace
+}  // namespace stokesrods
