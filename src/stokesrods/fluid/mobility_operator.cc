@@ -107,6 +107,23 @@ void MatrixFreeRssMobility::Update(const std::vector<HydroRod>& rods) {
     const double eps = params_.regularization * rods[static_cast<size_t>(r)].radius;
     for (int j = 0; j + 1 < x.cols(); ++j) segments_.push_back({first + j, eps});
   }
+  if (!far_) {
+    // Direct far sum below the size where the FMM may pay; above it the far field is only as
+    // accurate as the FMM's tolerance, so the quadrature need not be better either, and the
+    // near zone (exact closed forms, once per step) can shrink: Gauss points cost far less
+    // through the FMM than through the direct sum.
+    const double pairs = static_cast<double>(segments_.size()) * split_.gauss_points * m;
+    if (pairs < options_.direct_sum_below) {
+      far_ = MakeDirectStokesletSum();
+    } else {
+      far_ = MakeFastStokesletSum(
+          {.tolerance = options_.fast_sum_tolerance,
+           .direct_below_pairs = static_cast<std::int64_t>(options_.direct_sum_below),
+           .choose_by_cost = options_.fast_sum_by_cost});
+      split_ = ChooseNearFarSplit(std::max(options_.tolerance, options_.fast_sum_tolerance),
+                                  options_.fast_sum_near_delta);
+    }
+  }
   const double* alpha = nullptr;
   const double* weight = nullptr;
   GaussLegendreRule01(split_.gauss_points, &alpha, &weight);
@@ -119,15 +136,6 @@ void MatrixFreeRssMobility::Update(const std::vector<HydroRod>& rods) {
       gauss_points_.col(static_cast<Eigen::Index>(s) * g + q) = xa + alpha[q] * (xb - xa);
       gauss_eps_(static_cast<Eigen::Index>(s) * g + q) = segments_[s].eps;
     }
-  }
-  const double pairs = static_cast<double>(gauss_points_.cols()) * static_cast<double>(m);
-  if (!far_) {
-    far_ = pairs < options_.direct_sum_below
-               ? MakeDirectStokesletSum()
-               : MakeFastStokesletSum(
-                     {.tolerance = options_.fast_sum_tolerance,
-                      .direct_below_pairs = static_cast<std::int64_t>(options_.direct_sum_below),
-                      .choose_by_cost = options_.fast_sum_by_cost});
   }
   far_->Build(gauss_points_, gauss_eps_, nodes_);
   FindNearPairs(nodes_);
@@ -234,7 +242,7 @@ void MatrixFreeRssMobility::Apply(const VecX& force, VecX* velocity) const {
 
 }  // namespace
 
-NearFarSplit ChooseNearFarSplit(double tolerance) {
+NearFarSplit ChooseNearFarSplit(double tolerance, double max_near_delta) {
   // The n-point Gauss–Legendre rule on one segment–node pair, relative to the pair's |A|, at
   // δ = √(d² + ε²)/L: measured worst over random points and ε ∈ {0.05, 0.3} L (the table in
   // docs/performance.md; tests/fluid/mobility_operator_test.cc checks it), it falls like
@@ -250,7 +258,7 @@ NearFarSplit ChooseNearFarSplit(double tolerance) {
     split.gauss_points = n;  // GaussRuleError(n, δ_n) = tol
     split.near_delta =
         std::max(1.0, std::pow(GaussRuleError(n, 1.0) / tol, 1.0 / (2.0 * n - 1.0)));
-    if (split.near_delta <= 12.0) break;
+    if (split.near_delta <= max_near_delta) break;
   }
   return split;
 }

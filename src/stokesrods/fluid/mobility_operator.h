@@ -41,6 +41,9 @@ struct MobilityOptions {
   double fast_sum_tolerance = 1e-4;
   /// Matrix-free: false uses the FMM whenever the geometry allows it, paying or not (tests).
   bool fast_sum_by_cost = true;
+  /// Matrix-free with the fast sum: the largest near radius (segment lengths) for the split,
+  /// which then takes max(tolerance, fast_sum_tolerance) as the quadrature's tolerance [–].
+  double fast_sum_near_delta = 12.0;
 };
 
 class MobilityOperator {
@@ -89,6 +92,7 @@ struct NearFarSplit {
   int gauss_points = 3;
   double near_delta = 0.0;
 };
-NearFarSplit ChooseNearFarSplit(double tolerance);
+/// The fewest points whose near radius is at most `max_near_delta` segment lengths.
+NearFarSplit ChooseNearFarSplit(double tolerance, double max_near_delta = 12.0);
 
 }  // namespace stokesrods
