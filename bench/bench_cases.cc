@@ -9,6 +9,7 @@
 // Exit codes: 0 success, 2 invalid input (unknown case, bad option, bad --set), 3 a step failed
 // or memory ran out. The JSON line is printed in every case but a bad command line.
 #include <sys/resource.h>
+#include <time.h>
 
 #include <algorithm>
 #include <chrono>
@@ -200,6 +201,13 @@ double Median(std::vector<double> v) {
   return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+/// CPU time of the process (all threads) [ms].
+double ProcessCpuMs() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
+}
+
 /// NaN (no steps timed) as JSON null.
 nlohmann::ordered_json Number(double x) {
   return std::isfinite(x) ? nlohmann::ordered_json(x) : nlohmann::ordered_json(nullptr);
@@ -239,6 +247,7 @@ int RunCase(const Options& options, const CaseSpec& spec, nlohmann::ordered_json
   }
   std::vector<double> ms;
   long newton = 0, krylov = 0;
+  const double cpu_start = ProcessCpuMs();
   for (int k = 0; k < options.steps && failure.empty(); ++k) {
     const auto start = std::chrono::steady_clock::now();
     const StepReport r = Step(model, h, &state, &ws);
@@ -252,12 +261,16 @@ int RunCase(const Options& options, const CaseSpec& spec, nlohmann::ordered_json
     newton += r.newton_iterations;
     krylov += r.krylov_iterations;
   }
+  const double cpu_ms = ProcessCpuMs() - cpu_start;
   const double n = static_cast<double>(ms.size());
   const double mean = ms.empty() ? std::nan("") : std::accumulate(ms.begin(), ms.end(), 0.0) / n;
   j["steps"] = ms.size();
   j["warmup"] = options.warmup;
   j["ms_per_step_median"] = Number(Median(ms));
   j["ms_per_step_mean"] = Number(mean);
+  // CPU time of all threads over the timed steps (progress lines included), per step: on a shared
+  // machine the one-thread figure to compare, since other processes do not enter it.
+  j["cpu_ms_per_step"] = Number(ms.empty() ? std::nan("") : cpu_ms / n);
   j["newton_per_step"] = Number(ms.empty() ? std::nan("") : static_cast<double>(newton) / n);
   j["krylov_per_step"] = Number(ms.empty() ? std::nan("") : static_cast<double>(krylov) / n);
   j["wall_s_per_sim_s"] = Number(mean * 1e-3 / h);

@@ -91,8 +91,21 @@ Vec11 EdgeToStencilGradient(const Vec8& g) {
 }
 
 Mat11 EdgeToStencilHessian(const Mat8& h) {
-  static const Eigen::Matrix<double, 8, 11> m = EdgeMap();
-  return m.transpose() * h * m;
+  // Mᵀ h M with M = EdgeMap() applied by its ±1 pattern (e0 = x1 − x0, e1 = x2 − x1): a dense
+  // product costs 4× the arithmetic and, at these sizes, goes through Eigen's GEMM.
+  Eigen::Matrix<double, 8, 11> a;  // h M
+  a.middleCols<3>(0) = -h.middleCols<3>(kEdge0);
+  a.col(3) = h.col(kTheta0);
+  a.middleCols<3>(4) = h.middleCols<3>(kEdge0) - h.middleCols<3>(kEdge1);
+  a.col(7) = h.col(kTheta1);
+  a.middleCols<3>(8) = h.middleCols<3>(kEdge1);
+  Mat11 out;  // Mᵀ (h M)
+  out.middleRows<3>(0) = -a.middleRows<3>(kEdge0);
+  out.row(3) = a.row(kTheta0);
+  out.middleRows<3>(4) = a.middleRows<3>(kEdge0) - a.middleRows<3>(kEdge1);
+  out.row(7) = a.row(kTheta1);
+  out.middleRows<3>(8) = a.middleRows<3>(kEdge1);
+  return out;
 }
 
 }  // namespace stokesrods

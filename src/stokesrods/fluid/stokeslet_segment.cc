@@ -25,6 +25,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <limits>
 
 #include "stokesrods/common/assert.h"
 
@@ -150,18 +151,25 @@ const GaussLegendreRule& Rule(int n) {
 // Bernstein ellipses come closest to the interval at its ends (semi-major axis a = (ρ + 1/ρ)/2 = 1 + 2δ there), so
 // ρ ≥ ρ_min(δ) with ρ_min + 1/ρ_min = 2 + 4δ. The smallest δ for which n points suffice is
 // tabulated once from that bound: never fewer points than the exact rule.
+// kRoundOffMinDelta[n]: the smallest δ at which n points reach round-off (n ≥ 3).
+const std::array<double, kFarFieldPoints + 1> kRoundOffMinDelta = [] {
+  std::array<double, kFarFieldPoints + 1> t{};
+  for (int n = 3; n <= kFarFieldPoints; ++n) {
+    const double rho = std::exp(36.8 / (2.0 * (n - 2)));  // from n = ⌈36.8/(2 ln ρ)⌉ + 2
+    t[static_cast<size_t>(n)] = (rho + 1.0 / rho - 2.0) / 4.0;  // ρ + 1/ρ = 2 + 4δ
+  }
+  return t;
+}();
+
 int FarFieldPointCount(double delta) {
-  static const std::array<double, kFarFieldPoints + 1> kMinDelta = [] {
-    std::array<double, kFarFieldPoints + 1> t{};
-    for (int n = 3; n <= kFarFieldPoints; ++n) {
-      const double rho = std::exp(36.8 / (2.0 * (n - 2)));  // from n = ⌈36.8/(2 ln ρ)⌉ + 2
-      t[static_cast<size_t>(n)] = (rho + 1.0 / rho - 2.0) / 4.0;  // ρ + 1/ρ = 2 + 4δ
-    }
-    return t;
-  }();
   for (int n = 3; n < kFarFieldPoints; ++n)
-    if (delta >= kMinDelta[static_cast<size_t>(n)]) return n;
+    if (delta >= kRoundOffMinDelta[static_cast<size_t>(n)]) return n;
   return kFarFieldPoints;
+}
+
+// δ above which n points meet the tolerance: GaussRuleError(n, δ) = tolerance.
+double ToleranceMinDelta(int n, double tolerance) {
+  return std::pow(GaussRuleError(n, 1.0) / tolerance, 1.0 / (2.0 * n - 1.0));
 }
 
 SegmentMobility FarFieldSegment(const Vec3& xa, const Vec3& v, double length, double eps,
@@ -227,6 +235,16 @@ double GaussRuleError(int n, double delta) {
   return 2.0 * 9.6e-3 * std::pow(13.5, -(n - 2.0)) * std::pow(delta, -(2.0 * n - 1.0));
 }
 
+double GaussRuleMinDelta(int n, double tolerance) {
+  SR_ASSERT(n >= 1 && n <= kFarFieldPoints, "Gauss rule size out of range");
+  // StokesletSegment uses min(round-off count, the first n ≥ 2 meeting the tolerance) points.
+  double min_delta = n >= 3 ? kRoundOffMinDelta[static_cast<size_t>(n)]
+                            : std::numeric_limits<double>::infinity();
+  if (n == kFarFieldPoints) min_delta = 1.0;  // the round-off rule never uses more
+  if (tolerance > 0.0 && n >= 2) min_delta = std::min(min_delta, ToleranceMinDelta(n, tolerance));
+  return std::max(min_delta, 1.0);
+}
+
 SegmentMobility StokesletSegment(const Vec3& xa, const Vec3& xb, double regularization,
                                  const Vec3& point, double tolerance) {
   const Vec3 v = xb - xa;
@@ -250,8 +268,7 @@ SegmentMobility StokesletSegment(const Vec3& xa, const Vec3& xb, double regulari
       thread_local std::array<double, kFarFieldPoints + 1> min_delta{};
       if (tolerance != table_tolerance) {
         for (int n = 2; n <= kFarFieldPoints; ++n)
-          min_delta[static_cast<size_t>(n)] =
-              std::pow(GaussRuleError(n, 1.0) / tolerance, 1.0 / (2.0 * n - 1.0));
+          min_delta[static_cast<size_t>(n)] = ToleranceMinDelta(n, tolerance);
         table_tolerance = tolerance;
       }
       for (int n = 2; n < points; ++n)

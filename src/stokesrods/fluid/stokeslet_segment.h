@@ -51,6 +51,11 @@ double GaussRuleError(int n, double delta);
 SegmentMobility StokesletSegmentGauss(const Vec3& xa, const Vec3& xb, double regularization,
                                       const Vec3& point, int n);
 
+/// The smallest δ = √(d² + ε²)/L (never below 1, the closed forms' zone) from which an n-point
+/// Gauss–Legendre rule is at least as accurate as StokesletSegment(…, tolerance) there: where
+/// StokesletSegment would itself use n points or fewer. Infinity when no δ qualifies.
+double GaussRuleMinDelta(int n, double tolerance);
+
 /// Nodes (on [0, 1]) and weights (summing to 1) of the n-point Gauss–Legendre rule, 1 ≤ n ≤ 20.
 void GaussLegendreRule01(int n, const double** nodes, const double** weights);
 
