@@ -202,7 +202,7 @@ def table(rows):
     for r in rows:
         if r["ok"] and r["threads"] == 1:
             base[r["case"]] = r["ms_per_step_median"]
-    head = ["case", "rods", "h [ms]", "threads", "ms/step (median)", "Newton it./step",
+    head = ["case", "rods", "h [ms]", "threads", "ms/step (median)", "CPU ms/step", "Newton it./step",
             "s per simulated s", "peak memory [MB]", "speedup over 1 thread", "note"]
     lines = ["| " + " | ".join(head) + " |", "|" + " --- |" * len(head)]
     for r in rows:
@@ -216,6 +216,7 @@ def table(rows):
         cells = [r["case"], str(r.get("rods", ROD_COUNT[r["case"]])),
                  fmt_num(h * 1e3) if h else "–", str(r["threads"]),
                  fmt_num(r.get("ms_per_step_median")) if r["ok"] else "–",
+                 fmt_num(r.get("cpu_ms_per_step")) if r["ok"] else "–",
                  fmt_num(r.get("newton_per_step"), 2) if r["ok"] else "–",
                  fmt_num(r.get("wall_s_per_sim_s")) if r["ok"] else "–",
                  fmt_num(r.get("peak_rss_mb"), 3), speedup, note]

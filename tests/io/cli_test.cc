@@ -73,7 +73,7 @@ TEST(Cli, ShowConfigPrintsEveryDefaultAndTheDerivedQuantities) {
 }
 
 TEST(Cli, CantileverWritesTheSpecFiles) {
-  const fs::path out = fs::temp_directory_path() / "stokesrods_cli_cantilever";
+  const fs::path out = fs::temp_directory_path() / ("stokesrods_cli_cantilever." + std::to_string(getpid()));
   fs::remove_all(out);
   const Outcome o = RunCli(std::string("run ") + STOKESRODS_SOURCE_DIR + "/examples/cantilever.toml --output " + out.string());
   ASSERT_EQ(o.code, 0) << o.err;
@@ -116,7 +116,7 @@ TEST(Cli, UnwritableOutputIsExitFour) {
 }
 
 TEST(Cli, NumericalFailureIsExitThreeWithTheLastGoodStateSaved) {
-  const fs::path out = fs::temp_directory_path() / "stokesrods_cli_failure";
+  const fs::path out = fs::temp_directory_path() / ("stokesrods_cli_failure." + std::to_string(getpid()));
   fs::remove_all(out);
   // One Newton iteration cannot converge a step that starts far from equilibrium.
   const fs::path cfg = WriteConfig(
@@ -138,7 +138,7 @@ TEST(Cli, AFailedStepSaysWhenWhereAndWhatAndIsHalvedWhenAllowed) {
       "halve.toml", "[run]\nduration = 1.0\ntime_step = 0.25\n[fluid]\nmodel = \"none\"\n"
                     "[solver]\nnewton_max_iterations = 10\ndamping = 1.0\n[[rods]]\n"
                     "shape = \"straight\"\nnodes = 21\nloads = [{node = 20, force = [1e-3, 0.0, 0.0]}]\n");
-  const fs::path out = fs::temp_directory_path() / "stokesrods_cli_halve";
+  const fs::path out = fs::temp_directory_path() / ("stokesrods_cli_halve." + std::to_string(getpid()));
   fs::remove_all(out);
   const Outcome failed = RunCli("run " + cfg.string() + " --output " + out.string());
   EXPECT_EQ(failed.code, 3);
@@ -163,7 +163,7 @@ TEST(Cli, AFailedStepSaysWhenWhereAndWhatAndIsHalvedWhenAllowed) {
 }
 
 TEST(Cli, InterruptFlushesWritesACheckpointAndExits130) {
-  const fs::path out = fs::temp_directory_path() / "stokesrods_cli_interrupt";
+  const fs::path out = fs::temp_directory_path() / ("stokesrods_cli_interrupt." + std::to_string(getpid()));
   fs::remove_all(out);
   const fs::path cfg = WriteConfig("long.toml", "[run]\nduration = 1000.0\ntime_step = 0.01\n"
                                                 "[fluid]\nmodel = \"rss\"\n[[rods]]\nnodes = 21\n"
@@ -186,8 +186,8 @@ TEST(Cli, ResumeContinuesFromTheCheckpointAsIfNeverStopped) {
                            "checkpoint_interval = 0.1\nintegrator = \"bdf2\"\n[fluid]\nmodel = \"rss\"\n"
                            "[solver]\njacobian_max_age = 5\n[[rods]]\nnodes = 21\nomega_bar = 800\n";
   const fs::path cfg = WriteConfig("resume.toml", base);
-  const fs::path whole = fs::temp_directory_path() / "stokesrods_cli_whole";
-  const fs::path parts = fs::temp_directory_path() / "stokesrods_cli_parts";
+  const fs::path whole = fs::temp_directory_path() / ("stokesrods_cli_whole." + std::to_string(getpid()));
+  const fs::path parts = fs::temp_directory_path() / ("stokesrods_cli_parts." + std::to_string(getpid()));
   fs::remove_all(whole);
   fs::remove_all(parts);
   ASSERT_EQ(RunCli("run " + cfg.string() + " --set run.duration=0.6 --output " + whole.string()).code, 0);
@@ -212,7 +212,7 @@ TEST(Cli, ResumeContinuesFromTheCheckpointAsIfNeverStopped) {
 TEST(Cli, ResumeRefusesADamagedForeignOrMismatchedCheckpoint) {
   const fs::path cfg = WriteConfig("ck.toml", "[run]\nduration = 0.05\ntime_step = 0.01\n"
                                               "[fluid]\nmodel = \"rft\"\n[[rods]]\nnodes = 11\n");
-  const fs::path out = fs::temp_directory_path() / "stokesrods_cli_checkpoint";
+  const fs::path out = fs::temp_directory_path() / ("stokesrods_cli_checkpoint." + std::to_string(getpid()));
   fs::remove_all(out);
   const std::string run = "run " + cfg.string() + " --output " + out.string();
   ASSERT_EQ(RunCli(run).code, 0);

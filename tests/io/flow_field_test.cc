@@ -3,6 +3,8 @@
 // interaction; we allow 1e-6 of the largest speed).
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -47,7 +49,7 @@ std::vector<double> FlowWith(const std::string& mobility, const std::string& dir
 }
 
 TEST(FlowField, MatrixFreeMatchesDense) {
-  const std::string base = (std::filesystem::temp_directory_path() / "stokesrods_flow_test").string();
+  const std::string base = (std::filesystem::temp_directory_path() / ("stokesrods_flow_test." + std::to_string(getpid()))).string();
   const std::vector<double> dense = FlowWith("dense", base + "_dense");
   const std::vector<double> free = FlowWith("matrix_free", base + "_free");
   ASSERT_EQ(dense.size(), free.size());

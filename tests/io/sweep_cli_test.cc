@@ -2,6 +2,8 @@
 // a finished or an interrupted sweep, bad sweep files, and the same sweep under mpirun -n 2.
 #include <gtest/gtest.h>
 
+#include <string>
+
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -21,7 +23,7 @@ const char* kBase =
     "[[rods]]\nnodes = 11\nomega_bar = 100\n";
 
 fs::path Dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("stokesrods_sweep_cli." + name);
+  const fs::path dir = fs::temp_directory_path() / ("stokesrods_sweep_cli." + std::to_string(getpid()) + "." + name);
   fs::remove_all(dir);
   fs::create_directories(dir);
   std::ofstream(dir / "base.toml") << kBase;

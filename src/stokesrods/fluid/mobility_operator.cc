@@ -7,6 +7,7 @@
 
 #include "stokesrods/common/assert.h"
 #include "stokesrods/fluid/rss.h"
+#include "stokesrods/fluid/rss_rows.h"
 #include "stokesrods/fluid/stokeslet_segment.h"
 
 namespace stokesrods {
@@ -72,6 +73,7 @@ class MatrixFreeRssMobility final : public MobilityOperator {
   struct Segment {
     int a = 0;  // global node index of x_a (x_b is a + 1)
     double eps = 0.0;
+    int rod = 0;
   };
   void FindNearPairs(const Matrix3X& targets);
 
@@ -105,7 +107,7 @@ void MatrixFreeRssMobility::Update(const std::vector<HydroRod>& rods) {
     nodes_.middleCols(first, x.cols()) = x;
     inverse_voronoi_.segment(first, x.cols()) = VoronoiLengths(x).cwiseInverse();
     const double eps = params_.regularization * rods[static_cast<size_t>(r)].radius;
-    for (int j = 0; j + 1 < x.cols(); ++j) segments_.push_back({first + j, eps});
+    for (int j = 0; j + 1 < x.cols(); ++j) segments_.push_back({first + j, eps, r});
   }
   if (!far_) {
     // Direct far sum below the size where the FMM may pay; above it the far field is only as
@@ -161,43 +163,72 @@ void MatrixFreeRssMobility::FindNearPairs(const Matrix3X& targets) {
     const Vec3 mid = 0.5 * (nodes_.col(segments_[s].a) + nodes_.col(segments_[s].a + 1));
     grid[key(mid, 0, 0, 0)].push_back(static_cast<int>(s));
   }
+  // The exact near pairs minus the far sum's rule, by rows of RssRowKernel over the range of a
+  // rod's segments that are near a target (vectorized; columns of segments in the range that
+  // are not near are left out).
+  std::vector<RssRowKernel> kernels;
+  for (int r = 0; r < num_rods(); ++r)
+    kernels.emplace_back(*rods_[static_cast<size_t>(r)].x,
+                         params_.regularization * rods_[static_cast<size_t>(r)].radius,
+                         params_.far_field_tolerance, split_.gauss_points);
   const double scale = 1.0 / (8.0 * kPi * params_.viscosity);
   const int m = static_cast<int>(targets.cols());
-  // Per target, its (source node, block) list; targets in parallel, then concatenated in order.
   std::vector<std::vector<std::pair<int, Mat3>>> per_target(static_cast<size_t>(m));
-#pragma omp parallel for schedule(dynamic, 16)
-  for (int t = 0; t < m; ++t) {
-    const Vec3 p = targets.col(t);
-    std::vector<std::pair<int, Mat3>>& blocks = per_target[static_cast<size_t>(t)];
-    auto add = [&](int node, const Mat3& block) {
-      for (auto& [n, b] : blocks)
-        if (n == node) {
-          b += scale * inverse_voronoi_(node) * block;
-          return;
-        }
-      blocks.emplace_back(node, scale * inverse_voronoi_(node) * block);
-    };
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          const auto it = grid.find(key(p, dx, dy, dz));
-          if (it == grid.end()) continue;
-          for (int s : it->second) {
-            const Segment& seg = segments_[static_cast<size_t>(s)];
-            const Vec3 xa = nodes_.col(seg.a), xb = nodes_.col(seg.a + 1);
-            const Vec3 v = xb - xa;
-            const double alpha = std::clamp((p - xa).dot(v) / v.squaredNorm(), 0.0, 1.0);
-            const double d2 = (p - xa - alpha * v).squaredNorm() + seg.eps * seg.eps;
-            if (d2 >= split_.near_delta * split_.near_delta * v.squaredNorm()) continue;
-            // The near pair to the far-field tolerance (closed forms below δ = 1, else Gauss).
-            const SegmentMobility exact =
-                StokesletSegment(xa, xb, seg.eps, p, params_.far_field_tolerance);
-            const SegmentMobility rule =
-                StokesletSegmentGauss(xa, xb, seg.eps, p, split_.gauss_points);
-            add(seg.a, exact.a - rule.a);
-            add(seg.a + 1, exact.b - rule.b);
+#pragma omp parallel
+  {
+    std::vector<int> near;          // global segment indices near the target
+    std::vector<double> table;
+    std::vector<char> is_near;
+#pragma omp for schedule(dynamic, 16)
+    for (int t = 0; t < m; ++t) {
+      const Vec3 p = targets.col(t);
+      near.clear();
+      for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dz = -1; dz <= 1; ++dz) {
+            const auto it = grid.find(key(p, dx, dy, dz));
+            if (it == grid.end()) continue;
+            for (int s : it->second) {
+              const Segment& seg = segments_[static_cast<size_t>(s)];
+              const Vec3 xa = nodes_.col(seg.a), v = nodes_.col(seg.a + 1) - xa;
+              const double alpha = std::clamp((p - xa).dot(v) / v.squaredNorm(), 0.0, 1.0);
+              const double d2 = (p - xa - alpha * v).squaredNorm() + seg.eps * seg.eps;
+              if (d2 < split_.near_delta * split_.near_delta * v.squaredNorm()) near.push_back(s);
+            }
           }
+      std::sort(near.begin(), near.end());
+      std::vector<std::pair<int, Mat3>>& blocks = per_target[static_cast<size_t>(t)];
+      for (std::size_t i = 0; i < near.size();) {  // one rod at a time (segments in rod order)
+        const int rod = segments_[static_cast<size_t>(near[i])].rod;
+        const int rod_first_segment = node_offset(rod) - rod;  // N_k − 1 segments per rod
+        std::size_t end = i;
+        while (end < near.size() && segments_[static_cast<size_t>(near[end])].rod == rod) ++end;
+        const int lo = near[i] - rod_first_segment, hi = near[end - 1] - rod_first_segment;
+        const int count = hi - lo + 1;
+        table.resize(static_cast<size_t>(12 * count));
+        is_near.assign(static_cast<size_t>(count), 0);
+        for (std::size_t k = i; k < end; ++k)
+          is_near[static_cast<size_t>(near[k] - rod_first_segment - lo)] = 1;
+        const RssRowKernel& kernel = kernels[static_cast<size_t>(rod)];
+        kernel.Row(p, lo, count, table.data());
+        kernel.SubtractRule(p, lo, count, table.data());
+        // Node k (local) collects A_a of segment k and A_b of segment k − 1, near ones only.
+        for (int k = lo; k <= hi + 1; ++k) {
+          const bool a_near = k <= hi && is_near[static_cast<size_t>(k - lo)];
+          const bool b_near = k > lo && is_near[static_cast<size_t>(k - 1 - lo)];
+          if (!a_near && !b_near) continue;
+          double e[6];
+          for (int c = 0; c < 6; ++c)
+            e[c] = (a_near ? table[static_cast<size_t>(c * count + k - lo)] : 0.0) +
+                   (b_near ? table[static_cast<size_t>((6 + c) * count + k - 1 - lo)] : 0.0);
+          const int node = node_offset(rod) + k;
+          Mat3 block;
+          block << e[0], e[1], e[2], e[1], e[3], e[4], e[2], e[4], e[5];
+          blocks.emplace_back(node, (scale * inverse_voronoi_(node)) * block);
         }
+        i = end;
+      }
+    }
   }
   near_start_.assign(1, 0);
   near_source_.clear();
@@ -212,7 +243,7 @@ void MatrixFreeRssMobility::FindNearPairs(const Matrix3X& targets) {
 }
 
 void MatrixFreeRssMobility::Apply(const VecX& force, VecX* velocity) const {
-  const int m = nodes_.cols();
+  const auto m = static_cast<int>(nodes_.cols());
   SR_ASSERT(force.size() == 3 * m, "mobility: force vector of the wrong size");
   const int g = split_.gauss_points;
   const double* alpha = nullptr;
