@@ -62,7 +62,8 @@ void Gemm(const MatX& a, bool transpose_a, const MatX& b, double alpha, double b
 class FmmStokesletSum final : public StokesletSum {
  public:
   explicit FmmStokesletSum(const StokesletSumOptions& options)
-      : options_(options), direct_(MakeDirectStokesletSum()) {
+      : options_(options), single_(options.tolerance >= kSinglePrecisionTolerance),
+        direct_(MakeDirectStokesletSum(single_)) {
     SR_ASSERT(options.tolerance > 0.0 && options.tolerance < 1.0, "tolerance in (0, 1)");
   }
 
@@ -79,12 +80,16 @@ class FmmStokesletSum final : public StokesletSum {
   void GroupM2l();
 
   StokesletSumOptions options_;
+  bool single_ = false;  // near field and S2M in single precision (stokeslet_sum.h)
   std::unique_ptr<StokesletSum> direct_;
   bool use_direct_ = true;
   const FmmOperators* op_ = nullptr;
   FmmTree tree_;
   Matrix3X x_;        // targets in tree order
   mutable MatX src_;  // S × 7 sources in tree order (point_stokeslet.h), current strengths
+  Vec3 origin_ = Vec3::Zero();     // single precision: positions relative to it
+  mutable Eigen::MatrixXf src_f_;  // src_ in single precision
+  Eigen::Matrix3Xf x_f_;           // x_ in single precision
   // M2L pairs (target box, source box) per level and offset, in the order of the target boxes, and
   // their products' scratch.
   std::vector<std::array<std::vector<std::pair<int, int>>, 343>> m2l_pairs_;
@@ -155,6 +160,12 @@ void FmmStokesletSum::Build(const Matrix3X& sources, const VecX& regularization,
   x_.resize(3, targets.cols());
   for (Eigen::Index t = 0; t < targets.cols(); ++t)
     x_.col(t) = targets.col(tree_.target_order[static_cast<size_t>(t)]);
+  if (single_) {
+    origin_ = ns > 0 ? Vec3(sources.rowwise().mean()) : Vec3::Zero();
+    src_f_ = src_.cast<float>();
+    src_f_.leftCols<3>() = (src_.leftCols<3>().rowwise() - origin_.transpose()).cast<float>();
+    x_f_ = (x_.colwise() - origin_).cast<float>();
+  }
   const int levels = tree_.depth + 1;
   up_.assign(static_cast<size_t>(levels), MatX());
   check_.assign(static_cast<size_t>(levels), MatX());
@@ -190,6 +201,7 @@ void FmmStokesletSum::Apply(const Matrix3X& strengths, Matrix3X* w) const {
   SR_ASSERT(strengths.cols() == src_.rows(), "one strength per source");
   for (Eigen::Index s = 0; s < src_.rows(); ++s)
     src_.row(s).tail<3>() = strengths.col(tree_.source_order[static_cast<size_t>(s)]).transpose();
+  if (single_) src_f_.rightCols<3>() = src_.rightCols<3>().cast<float>();
   Upward();
   Downward();
   Matrix3X sorted;
@@ -204,6 +216,7 @@ void FmmStokesletSum::Upward() const {
   const int leaf = tree_.depth;
   const auto& boxes = tree_.levels[static_cast<size_t>(leaf)];
   const SourceColumns columns = Columns(src_);
+  const SourceColumnsF columns_f = single_ ? ColumnsF(src_f_) : SourceColumnsF{};
   const double width = tree_.BoxWidth(leaf);
   MatX& check = check_[static_cast<size_t>(leaf)];
   const int n = op_->points;
@@ -215,8 +228,13 @@ void FmmStokesletSum::Upward() const {
     const Vec3 centre = tree_.BoxCentre(leaf, box.code);
     for (int i = 0; i < n; ++i) {
       const Vec3 p = centre + (kFmmOuterRadius * width) * op_->surface.col(i);
-      AddPointSum(columns, box.src_begin, box.src_end, p.data(),
-                  check.col(static_cast<Eigen::Index>(b)).data() + 3 * i);
+      double* out = check.col(static_cast<Eigen::Index>(b)).data() + 3 * i;
+      if (single_) {
+        const Eigen::Vector3f pf = (p - origin_).cast<float>();
+        AddPointSumSingle(columns_f, box.src_begin, box.src_end, pf.data(), out);
+      } else {
+        AddPointSum(columns, box.src_begin, box.src_end, p.data(), out);
+      }
     }
   }
   Gemm(op_->check_to_up, false, check, width, 0.0, &up_[static_cast<size_t>(leaf)]);
@@ -276,6 +294,7 @@ void FmmStokesletSum::Leaves(Matrix3X* w) const {
   const int leaf = tree_.depth;
   const auto& boxes = tree_.levels[static_cast<size_t>(leaf)];
   const SourceColumns columns = Columns(src_);
+  const SourceColumnsF columns_f = single_ ? ColumnsF(src_f_) : SourceColumnsF{};
   const double width = tree_.BoxWidth(leaf);
   const int n = op_->points;
   w->setZero(3, x_.cols());
@@ -299,7 +318,10 @@ void FmmStokesletSum::Leaves(Matrix3X* w) const {
         AddPointSum(far, 0, n, x_.col(t).data(), out);
         for (int e = tree_.near.start[b]; e < tree_.near.start[b + 1]; ++e) {
           const FmmBox& a = boxes[static_cast<size_t>(tree_.near.box[static_cast<size_t>(e)])];
-          AddPointSum(columns, a.src_begin, a.src_end, x_.col(t).data(), out);
+          if (single_)
+            AddPointSumSingle(columns_f, a.src_begin, a.src_end, x_f_.col(t).data(), out);
+          else
+            AddPointSum(columns, a.src_begin, a.src_end, x_.col(t).data(), out);
         }
       }
     }

@@ -38,6 +38,33 @@ void AddPointSum(const SourceColumns& c, Eigen::Index begin, Eigen::Index end, c
   w[2] += wz;
 }
 
+SourceColumnsF ColumnsF(const Eigen::MatrixXf& src) {
+  return {src.col(0).data(), src.col(1).data(), src.col(2).data(), src.col(3).data(),
+          src.col(4).data(), src.col(5).data(), src.col(6).data()};
+}
+
+__attribute__((target_clones("avx512f", "avx2", "default")))
+void AddPointSumSingle(const SourceColumnsF& c, Eigen::Index begin, Eigen::Index end,
+                       const float* x, double* w) {
+  const float *sx = c.x, *sy = c.y, *sz = c.z, *se2 = c.e2, *gx = c.gx, *gy = c.gy, *gz = c.gz;
+  const float px = x[0], py = x[1], pz = x[2];
+  float wx = 0.0f, wy = 0.0f, wz = 0.0f;
+#pragma omp simd reduction(+ : wx, wy, wz)
+  for (Eigen::Index s = begin; s < end; ++s) {
+    const float rx = px - sx[s], ry = py - sy[s], rz = pz - sz[s];
+    const float inv_r = 1.0f / std::sqrt(rx * rx + ry * ry + rz * rz + se2[s]);
+    const float inv_r3 = inv_r * inv_r * inv_r;
+    const float a = inv_r + se2[s] * inv_r3;
+    const float b = (rx * gx[s] + ry * gy[s] + rz * gz[s]) * inv_r3;
+    wx += a * gx[s] + b * rx;
+    wy += a * gy[s] + b * ry;
+    wz += a * gz[s] + b * rz;
+  }
+  w[0] += wx;
+  w[1] += wy;
+  w[2] += wz;
+}
+
 MatX SourceMatrix(const Matrix3X& sources, const VecX& regularization) {
   MatX src(sources.cols(), 7);
   src.leftCols<3>() = sources.transpose();
@@ -50,18 +77,33 @@ namespace {
 
 class DirectStokesletSum final : public StokesletSum {
  public:
+  explicit DirectStokesletSum(bool single) : single_(single) {}
+
   void Build(const Matrix3X& sources, const VecX& regularization,
              const Matrix3X& targets) override {
     SR_ASSERT(regularization.size() == sources.cols(), "one ε per source");
     src_ = SourceMatrix(sources, regularization);
     targets_ = targets;
+    if (!single_) return;
+    origin_ = sources.cols() > 0 ? Vec3(sources.rowwise().mean()) : Vec3::Zero();
+    src_f_ = src_.cast<float>();
+    src_f_.leftCols<3>() = (sources.colwise() - origin_).transpose().cast<float>();
+    targets_f_ = (targets.colwise() - origin_).cast<float>();
   }
 
   void Apply(const Matrix3X& strengths, Matrix3X* w) const override {
     SR_ASSERT(strengths.cols() == src_.rows(), "one strength per source");
     const Eigen::Index nt = targets_.cols();
-    src_.rightCols<3>() = strengths.transpose();
     w->setZero(3, nt);
+    if (single_) {
+      src_f_.rightCols<3>() = strengths.transpose().cast<float>();
+      const SourceColumnsF c = ColumnsF(src_f_);
+#pragma omp parallel for schedule(static)
+      for (Eigen::Index t = 0; t < nt; ++t)
+        AddPointSumSingle(c, 0, src_f_.rows(), targets_f_.col(t).data(), w->col(t).data());
+      return;
+    }
+    src_.rightCols<3>() = strengths.transpose();
     const SourceColumns c = Columns(src_);
 #pragma omp parallel for schedule(static)
     for (Eigen::Index t = 0; t < nt; ++t)
@@ -76,14 +118,18 @@ class DirectStokesletSum final : public StokesletSum {
   }
 
  private:
+  bool single_ = false;
   mutable MatX src_;  // S × 7, the strengths are those of the current Apply
   Matrix3X targets_;
+  Vec3 origin_ = Vec3::Zero();       // single precision: positions relative to it
+  mutable Eigen::MatrixXf src_f_;
+  Eigen::Matrix3Xf targets_f_;
 };
 
 }  // namespace
 
-std::unique_ptr<StokesletSum> MakeDirectStokesletSum() {
-  return std::make_unique<DirectStokesletSum>();
+std::unique_ptr<StokesletSum> MakeDirectStokesletSum(bool single_precision) {
+  return std::make_unique<DirectStokesletSum>(single_precision);
 }
 
 }  // namespace stokesrods

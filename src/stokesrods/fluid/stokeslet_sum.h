@@ -54,8 +54,15 @@ class StokesletSum {
   virtual StokesletSumStats Stats() const = 0;
 };
 
-/// The direct sum (OpenMP over targets): exact to rounding, O(S T) per Apply.
-std::unique_ptr<StokesletSum> MakeDirectStokesletSum();
+/// The direct sum (OpenMP over targets): exact to rounding, O(S T) per Apply. In single precision
+/// (the fast sum's fallback at tolerances ≥ kSinglePrecisionTolerance) each term is exact to
+/// ~1e-7 of itself plus the positions' rounding (point_stokeslet.h).
+std::unique_ptr<StokesletSum> MakeDirectStokesletSum(bool single_precision = false);
+
+/// The fast sum computes its kernel evaluations in single precision from this tolerance on:
+/// float's ~6e-8 rounding of the terms and of positions (~1e-7 of the lattice's extent, 1e-5 of
+/// ε = 1 mm at 0.4 m) stays ten times below it (measured: tests/fluid/stokeslet_sum_test.cc).
+inline constexpr double kSinglePrecisionTolerance = 1e-4;
 
 /// The fast sum (a kernel-independent fast multipole method; see fmm_sum.cc for the method and
 /// its error control). Falls back to the direct sum for small problems and where it does not pay.
