@@ -7,7 +7,47 @@
 #include "stokesrods/sim/state.h"
 #include "stokesrods/solver/gmres.h"
 
+extern "C" void sgemv_(const char* trans, const int* m, const int* n, const float* alpha,
+                       const float* a, const int* lda, const float* x, const int* incx,
+                       const float* beta, float* y, const int* incy);
+
 namespace stokesrods {
+
+namespace {
+
+// y = A x by the BLAS (OpenBLAS: vectorized for the CPU at hand and threaded; the build targets
+// baseline x86-64, where Eigen's product would use SSE2 only). Memory bound at these sizes.
+void Gemv(const Eigen::MatrixXf& a, const Eigen::VectorXf& x, Eigen::VectorXf* y) {
+  const int m = static_cast<int>(a.rows()), n = static_cast<int>(a.cols()), one = 1;
+  const float alpha = 1.0f, beta = 0.0f;
+  y->resize(m);
+  if (m == 0 || n == 0) {
+    y->setZero();
+    return;
+  }
+  sgemv_("N", &m, &n, &alpha, a.data(), &m, x.data(), &one, &beta, y->data(), &one);
+}
+
+// t = Σ_j over n points of (1/R + ε_j²/R³, then r rᵀ/R³ as xx, xy, xz, yy, yz, zz),
+// r = p − x_j, R² = |r|² + ε_j²: the point Stokeslets S_ε of a chunk of nodes at p, summed.
+__attribute__((target_clones("avx512f", "avx2", "default")))
+void SumPointStokeslets(const double* xs, const double* ys, const double* zs, const double* e2,
+                        int n, const double* p, double t[7]) {
+  const double px = p[0], py = p[1], pz = p[2];
+  double diag = 0, sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0;
+#pragma omp simd reduction(+ : diag, sxx, sxy, sxz, syy, syz, szz)
+  for (int j = 0; j < n; ++j) {
+    const double rx = px - xs[j], ry = py - ys[j], rz = pz - zs[j];
+    const double inv = 1.0 / std::sqrt(rx * rx + ry * ry + rz * rz + e2[j]);
+    const double inv3 = inv * inv * inv;
+    diag += inv + e2[j] * inv3;
+    sxx += rx * rx * inv3, sxy += rx * ry * inv3, sxz += rx * rz * inv3;
+    syy += ry * ry * inv3, syz += ry * rz * inv3, szz += rz * rz * inv3;
+  }
+  t[0] = diag, t[1] = sxx, t[2] = sxy, t[3] = sxz, t[4] = syy, t[5] = syz, t[6] = szz;
+}
+
+}  // namespace
 
 void GatherNodeVelocities(const Model& model, const VecX& q, const VecX& q_start, double h,
                           VecX* u) {
@@ -216,7 +256,7 @@ void HydroCoupling::BuildCoarseLevel(const Model& model, double h,
   for (std::size_t r = 0; r < model.rods.size(); ++r)
     std::fill_n(node_rod.begin() + model.rods[r].node_offset, model.rods[r].num_nodes(),
                 static_cast<int>(r));
-  Matrix3X x(3, m);
+  Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor> x(3, m);  // rows contiguous
   VecX eps2(m);
   for (std::size_t r = 0; r < model.rods.size(); ++r) {
     x.middleCols(model.rods[r].node_offset, model.rods[r].num_nodes()) = positions_[r];
@@ -228,6 +268,7 @@ void HydroCoupling::BuildCoarseLevel(const Model& model, double h,
 #pragma omp parallel for schedule(dynamic, 16)
   for (int i = 0; i < m; ++i) {
     const int rod_i = node_rod[static_cast<size_t>(i)];
+    const Vec3 point = x.col(i);
     const int first_i = model.rods[static_cast<size_t>(rod_i)].node_offset;
     for (int b = 0; b < nc; ++b) {
       const int rod_b = chunk_rod[static_cast<size_t>(b)];
@@ -236,26 +277,22 @@ void HydroCoupling::BuildCoarseLevel(const Model& model, double h,
         for (int j = chunk_first_[static_cast<size_t>(b)]; j < chunk_first_[static_cast<size_t>(b) + 1]; ++j)
           sum += blocks[static_cast<size_t>(rod_i)].block<3, 3>(3 * (i - first_i), 3 * (j - first_i));
       } else {               // between rods: a point Stokeslet per node (the nodal force F_j)
-        double sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0, diag = 0;
-        for (int j = chunk_first_[static_cast<size_t>(b)]; j < chunk_first_[static_cast<size_t>(b) + 1]; ++j) {
-          const double rx = x(0, i) - x(0, j), ry = x(1, i) - x(1, j), rz = x(2, i) - x(2, j);
-          const double e2 = eps2(j);
-          const double inv = 1.0 / std::sqrt(rx * rx + ry * ry + rz * rz + e2);
-          const double inv3 = inv * inv * inv;
-          diag += inv + e2 * inv3;
-          sxx += rx * rx * inv3; sxy += rx * ry * inv3; sxz += rx * rz * inv3;
-          syy += ry * ry * inv3; syz += ry * rz * inv3; szz += rz * rz * inv3;
-        }
-        sum << diag + sxx, sxy, sxz, sxy, diag + syy, syz, sxz, syz, diag + szz;
+        const int begin = chunk_first_[static_cast<size_t>(b)];
+        const int end = chunk_first_[static_cast<size_t>(b) + 1];
+        double t[7];  // Σ (1/R + ε²/R³), then the six entries of Σ r rᵀ/R³
+        SumPointStokeslets(x.row(0).data() + begin, x.row(1).data() + begin,
+                           x.row(2).data() + begin, eps2.data() + begin, end - begin,
+                           point.data(), t);
+        sum << t[0] + t[1], t[2], t[3], t[2], t[0] + t[4], t[5], t[3], t[5], t[0] + t[6];
         sum *= scale;
       }
-      coarse_w_.block<3, 3>(3 * i, 3 * b) = sum;
+      coarse_w_.block<3, 3>(3 * i, 3 * b) = sum.cast<float>();
     }
   }
   MatX e = MatX::Zero(3 * nc, 3 * nc);  // E = Zᵀ W: rows of W summed over each chunk
   for (int a = 0; a < nc; ++a)
     for (int i = chunk_first_[static_cast<size_t>(a)]; i < chunk_first_[static_cast<size_t>(a) + 1]; ++i)
-      e.middleRows<3>(3 * a) += coarse_w_.middleRows<3>(3 * i);
+      e.middleRows<3>(3 * a) += coarse_w_.middleRows<3>(3 * i).cast<double>();
   coarse_lu_.compute(e);
 }
 
@@ -271,7 +308,9 @@ void HydroCoupling::Precondition(const VecX& v, VecX* out) const {
     for (int i = chunk_first_[static_cast<size_t>(a)]; i < chunk_first_[static_cast<size_t>(a) + 1]; ++i)
       zv.segment<3>(3 * a) += v.segment<3>(3 * i);
   const VecX coarse = coarse_lu_.solve(zv);
-  const VecX rest = v - coarse_w_ * coarse;
+  Eigen::VectorXf wc;
+  Gemv(coarse_w_, coarse.cast<float>(), &wc);
+  const VecX rest = v - wc.cast<double>();
   out->resize(v.size());
   for (int r = 0; r < mobility_->num_rods(); ++r) {
     const int first = 3 * mobility_->node_offset(r);

@@ -112,7 +112,8 @@ class HydroCoupling {
   std::vector<Eigen::PartialPivLU<MatX>> block_lu_;
   void BuildCoarseLevel(const Model& model, double h, const std::vector<MatX>& blocks);
   std::vector<int> chunk_first_;   ///< first global node of each chunk; back() = M
-  MatX coarse_w_;                  ///< W ≈ C Z (3M × 3 chunks)
+  Eigen::MatrixXf coarse_w_;       ///< W ≈ C Z (3M × 3 chunks), single precision (a
+                                   ///< preconditioner; half the memory each product streams)
   Eigen::PartialPivLU<MatX> coarse_lu_;  ///< of E = Zᵀ W
   bool block_preconditioner_ = false;
   int iterations_after_refresh_ = -1;
