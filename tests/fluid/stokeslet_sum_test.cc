@@ -220,7 +220,7 @@ TEST(StokesletSumTest, SixDecadesOfDistance) {
 
 // The single-precision direct sum (the fast sum's kernels from kSinglePrecisionTolerance = 1e-4)
 // against the double one, on the 100-helix lattice (extent 0.4 m, ε = 1.02 mm: the positions'
-// rounding is largest there) and a random cloud; measured 2.1e-7 and 8.3e-8 in the norm of
+// rounding is largest there) and a random cloud; measured 2.0e-7 and 8.2e-8 in the norm of
 // stokeslet_sum.h, allowed a tenth of the tolerance that selects it.
 TEST(StokesletSumTest, SinglePrecisionDirectSumIsWellWithinItsTolerance) {
   std::mt19937 rng(11);

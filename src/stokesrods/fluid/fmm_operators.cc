@@ -73,7 +73,9 @@ std::unique_ptr<FmmOperators> MakeOperators(int order, double cutoff) {
   for (std::size_t i = 0; i < offsets.size(); ++i) {
     const auto [x, y, z] = offsets[i];
     const Matrix3X source = inner.colwise() + Vec3(x, y, z);  // the box at offset v = source − target
-    op->m2l[static_cast<size_t>(M2lIndex(x, y, z))] = KernelMatrix(inner, source);
+    const auto index = static_cast<size_t>(M2lIndex(x, y, z));
+    op->m2l[index] = KernelMatrix(inner, source);
+    op->m2l_single[index] = op->m2l[index].cast<float>();
   }
   return op;
 }

@@ -35,6 +35,7 @@ struct FmmOperators {
   std::array<MatX, 8> l2l;       ///< parent's downward densities → child c's
   MatX check_to_down;            ///< downward check (r_in) → downward equivalent (r_out)
   std::array<MatX, 343> m2l;     ///< K_v for M2lIndex(v) > 171 (see M2lMatrix), else empty
+  std::array<Eigen::MatrixXf, 343> m2l_single;  ///< the same in single precision
 };
 
 inline constexpr double kFmmInnerRadius = 0.525;  ///< r_in in box widths
@@ -42,7 +43,7 @@ inline constexpr double kFmmOuterRadius = 1.475;  ///< r_out in box widths
 
 /// The operators for p = order (2 ≤ p ≤ 12) and the relative cutoff of the pseudo-inverses;
 /// computed on first use (thread-safe; 0.1, 0.4, 1.5 s for p = 4, 5, 6), then cached for the
-/// process (K_v: 36, 110, 260 MB).
+/// process (K_v: 36, 110, 260 MB, and half that again in single precision).
 const FmmOperators& GetFmmOperators(int order, double cutoff);
 
 /// Index of offset v in FmmOperators::m2l; index 342 − i is offset −v.
@@ -52,6 +53,9 @@ inline int M2lIndex(int vx, int vy, int vz) { return (vx + 3) * 49 + (vy + 3) * 
 inline bool M2lIsTransposed(int index) { return index < 171; }
 inline const MatX& M2lMatrix(const FmmOperators& op, int index) {
   return op.m2l[static_cast<size_t>(M2lIsTransposed(index) ? 342 - index : index)];
+}
+inline const Eigen::MatrixXf& M2lMatrixSingle(const FmmOperators& op, int index) {
+  return op.m2l_single[static_cast<size_t>(M2lIsTransposed(index) ? 342 - index : index)];
 }
 
 }  // namespace stokesrods

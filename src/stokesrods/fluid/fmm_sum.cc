@@ -16,6 +16,10 @@
 // (bench_stokeslet_sum); deeper, each M2L (3n × 3n = 168² at p = 4) costs as much as summing
 // the two boxes' 30–70 points directly.
 //
+// PRECISION. From kSinglePrecisionTolerance (1e-4, stokeslet_sum.h) on, the near field, S2M and
+// the M2L products run in single precision (float SIMD lanes and sgemm; the fits, M2M, L2L and L2T
+// stay double): the measured errors at p = 4 are unchanged (tests/fluid/stokeslet_sum_test.cc).
+//
 // REGULARIZATION. Far (V-list) pairs are approximated by Stokes flows, while S_ε is one only up
 // to O((ε/r)⁴): S_ε = S + (ε²/2)(I − 3 r̂r̂ᵀ)/r³ + ε⁴(−9/8 I + 15/8 r̂r̂ᵀ)/r⁵ + …, whose ε² term
 // (a potential dipole) is a Stokes flow the equivalent densities reproduce (S2M uses S_ε itself)
@@ -41,6 +45,10 @@ namespace {
 
 constexpr double kEpsilonConstant = 2.0;  // c_ε
 
+extern "C" void sgemm_(const char* transa, const char* transb, const int* m, const int* n,
+                       const int* k, const float* alpha, const float* a, const int* lda,
+                       const float* b, const int* ldb, const float* beta, float* c,
+                       const int* ldc);
 extern "C" void dgemm_(const char* transa, const char* transb, const int* m, const int* n,
                        const int* k, const double* alpha, const double* a, const int* lda,
                        const double* b, const int* ldb, const double* beta, double* c,
@@ -56,6 +64,18 @@ void Gemm(const MatX& a, bool transpose_a, const MatX& b, double alpha, double b
   const int lda = static_cast<int>(a.rows()), ldb = k, ldc = m;
   const char ta = transpose_a ? 'T' : 'N', tb = 'N';
   dgemm_(&ta, &tb, &m, &n, &k, &alpha, a.data(), &lda, b.data(), &ldb, &beta, c->data(), &ldc);
+}
+
+/// The same in single precision (the M2L of the single-precision sum).
+void Gemm(const Eigen::MatrixXf& a, bool transpose_a, const Eigen::MatrixXf& b, Eigen::MatrixXf* c) {
+  const int m = static_cast<int>(transpose_a ? a.cols() : a.rows());
+  const int n = static_cast<int>(b.cols()), k = static_cast<int>(b.rows());
+  c->resize(m, n);
+  if (m == 0 || n == 0) return;
+  const int lda = static_cast<int>(a.rows()), ldb = k, ldc = m;
+  const char ta = transpose_a ? 'T' : 'N', tb = 'N';
+  const float alpha = 1.0f, beta = 0.0f;
+  sgemm_(&ta, &tb, &m, &n, &k, &alpha, a.data(), &lda, b.data(), &ldb, &beta, c->data(), &ldc);
 }
 
 
@@ -94,6 +114,7 @@ class FmmStokesletSum final : public StokesletSum {
   // their products' scratch.
   std::vector<std::array<std::vector<std::pair<int, int>>, 343>> m2l_pairs_;
   mutable MatX m2l_in_, m2l_out_;
+  mutable Eigen::MatrixXf m2l_in_f_, m2l_out_f_;
   mutable std::vector<MatX> up_, check_, down_;  // per level: 3n × boxes
   StokesletSumStats stats_;
 };
@@ -282,6 +303,15 @@ void FmmStokesletSum::M2l(int level) const {
     const auto& list = pairs[static_cast<size_t>(o)];
     const auto m = static_cast<Eigen::Index>(list.size());
     if (m == 0) continue;
+    if (single_) {
+      m2l_in_f_.resize(up.rows(), m);
+      for (Eigen::Index j = 0; j < m; ++j)
+        m2l_in_f_.col(j) = up.col(list[static_cast<size_t>(j)].second).cast<float>();
+      Gemm(M2lMatrixSingle(*op_, o), M2lIsTransposed(o), m2l_in_f_, &m2l_out_f_);
+      for (Eigen::Index j = 0; j < m; ++j)
+        check.col(list[static_cast<size_t>(j)].first) += m2l_out_f_.col(j).cast<double>();
+      continue;
+    }
     m2l_in_.resize(up.rows(), m);
     for (Eigen::Index j = 0; j < m; ++j) m2l_in_.col(j) = up.col(list[static_cast<size_t>(j)].second);
     Gemm(M2lMatrix(*op_, o), M2lIsTransposed(o), m2l_in_, 1.0, 0.0, &m2l_out_);
