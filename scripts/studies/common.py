@@ -75,15 +75,56 @@ def first_number(text):
     return float(text.strip("[] ").split(",")[0])
 
 
-def sweep_study_main(sweep_files, plot):
-    """Command line of a sweep study: `run` runs the sweeps (resuming) then plots; `plot` plots."""
+def case_table(sweep_dir, *analyze_args):
+    """`stokesrods analyze` rows of a sweep joined with sweep.csv's wall time; ([] if never run)."""
+    if not os.path.exists(os.path.join(sweep_dir, "sweep.json")):
+        return [], []
+    rows, lines = analyze(sweep_dir, *analyze_args)
+    wall = {r["case"]: r["wall_seconds"] for r in read_csv(os.path.join(sweep_dir, "sweep.csv"))}
+    for r in rows:
+        r["wall_seconds"] = wall.get(r["case"], "")
+    return rows, lines
+
+
+def write_csv(path, header, rows):
+    """rows: sequences in the order of header; writes path (a committed table) and logs it."""
+    import csv
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f, lineterminator="\n")
+        w.writerow(header)
+        w.writerows(rows)
+    log("wrote", path, f"({len(rows)} rows)")
+
+
+def crossing_marker(ax, x, y, crossed):
+    """One case of a crossing diagram: ● crossed (Δb ≤ 0 at the end), △ not."""
+    ax.plot(x, y, "o" if crossed else "^", ms=5, mfc="tab:blue" if crossed else "none",
+            mec="tab:blue" if crossed else "tab:red")
+
+
+def finish_crossing_axes(ax, xlabel, title_prefix="", legend_loc="best"):
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("ω̄")
+    ax.set_title(f"{title_prefix}crossed at t̄ = 2 (●) or not (△)", fontsize=9)
+    ax.legend(fontsize=7, loc=legend_loc)
+
+
+def sweep_study_main(sweep_files, table, plot):
+    """Command line of a sweep study.
+
+    run    the sweeps (finished cases are skipped, interrupted ones resume), then table and plot
+    table  `stokesrods analyze` on the run folders -> the tables in docs/validation/
+    plot   the figure from the tables in docs/validation/ alone (no run folder needed)
+    """
     import argparse
     p = argparse.ArgumentParser()
-    p.add_argument("what", choices=["run", "plot"])
-    p.add_argument("--jobs", type=int, default=2)
+    p.add_argument("what", choices=["run", "table", "plot"])
+    p.add_argument("--jobs", type=int, default=1)
     args = p.parse_args()
     os.makedirs(os.path.join(ROOT, "docs", "validation"), exist_ok=True)
     if args.what == "run":
         for sweep_file in sweep_files:
             run_sweep(sweep_file, args.jobs)
+    if args.what in ("run", "table"):
+        table()
     plot()

@@ -1,88 +1,109 @@
 #!/usr/bin/python3
 """Paper Fig. 8: the propulsive force of two flagella against speed and distance.
 
-  fig8_propulsion.py run    the sweeps fig8a_single.toml and fig8b_distance.toml (fig7c3_phase.toml
-                            supplies Δt/R = 4, 6, 8 of Fig. 8a; run it with fig7c3_phase.py)
-  fig8_propulsion.py plot   docs/validation/fig8_propulsion.{png,csv}
+  fig8_propulsion.py run     the sweeps fig8a_single.toml and fig8b_distance.toml (resume), then table, plot
+                             (fig7c3_phase.toml supplies Δt/R = 4, 6, 8 of Fig. 8a: run fig7c3_phase.py first)
+  fig8_propulsion.py table   docs/validation/fig8_single_cases.csv, fig8b_cases.csv (stokesrods analyze)
+                             and the summary fig8_propulsion.csv (fits of those and of fig7c3_cases.csv)
+  fig8_propulsion.py plot    docs/validation/fig8_propulsion.png from those tables alone
 
 F̄p (eq. 26, both rods' clamp reactions along z over EI/l0²) is the time average over the second half
 of each run (t̄ ∈ [1, 2]); `stokesrods analyze` computes it and its ratio to one flagellum at the
 same ω̄. Fig. 8(a)'s lines are least-squares fits through the origin, F̄p = k ω̄; Δt = ∞ is twice
-one flagellum. The reduction at Δt/R = d is 1 − k_d / k_∞.
+one flagellum. The reduction at Δt/R = d is 1 − k_d / k_∞ (also given with the final values of F̄p
+instead of the averages, as a check of how much the choice matters).
 """
 import os
 
 import numpy as np
 
-from common import ROOT, analyze, first_number, log, sweep_study_main
+from common import ROOT, case_table, first_number, log, read_csv, sweep_study_main, write_csv
 
 OUT = os.path.join(ROOT, "out", "studies")
 DOCS = os.path.join(ROOT, "docs", "validation")
+SINGLE = os.path.join(DOCS, "fig8_single_cases.csv")
+PAIRS = os.path.join(DOCS, "fig7c3_cases.csv")
+FAR = os.path.join(DOCS, "fig8b_cases.csv")
+SUMMARY = os.path.join(DOCS, "fig8_propulsion.csv")
 R = 0.01
 PAPER_REDUCTION = {4: 40.0, 6: 31.7, 8: 20.2}
+FORCE = ["propulsive_force_bar_mean", "propulsive_force_bar_final"]
 
 
-def completed(rows):
-    return [r for r in rows if r["status"] == "completed"]
+def table():
+    single_dir = os.path.join(OUT, "fig8_single")
+    single, _ = case_table(single_dir)
+    rows = sorted((float(r["omega_bar"]), r) for r in single if r["status"] == "completed")
+    write_csv(SINGLE, ["omega_bar"] + FORCE + ["wall_seconds"],
+              [[f"{w:g}"] + [r[c] for c in FORCE + ["wall_seconds"]] for w, r in rows])
+    far, _ = case_table(os.path.join(OUT, "fig8b"), "--single", single_dir)
+    rows = sorted((first_number(r["rods.2.base"]) / R, r) for r in far if r["status"] == "completed")
+    write_csv(FAR, ["delta_t_over_R"] + FORCE + ["propulsive_force_ratio_to_single", "wall_seconds"],
+              [[f"{d:g}"] + [r[c] for c in FORCE + ["propulsive_force_ratio_to_single", "wall_seconds"]]
+               for d, r in rows])
+    write_csv(SUMMARY, ["delta_t_over_R", "points", "speeds", "slope_of_mean", "reduction_percent",
+                        "paper_reduction_percent", "slope_of_final", "reduction_of_final_percent"],
+              summary_rows(series()))
+
+
+def series():
+    """{Δt/R: [(ω̄, F̄p mean, F̄p final)]} from the committed case tables; ∞ = twice one flagellum."""
+    out = {np.inf: [(float(r["omega_bar"]), 2 * float(r[FORCE[0]]), 2 * float(r[FORCE[1]]))
+                    for r in read_csv(SINGLE)]}
+    for r in read_csv(PAIRS):
+        d = float(r["delta_t_over_R"])
+        if d in PAPER_REDUCTION:
+            out.setdefault(d, []).append((float(r["omega_bar"]), float(r[FORCE[0]]), float(r[FORCE[1]])))
+    return {d: np.array(sorted(v)) for d, v in out.items() if v}
+
+
+def slope(points, column):
+    """Least-squares slope through the origin of F̄p (column 1 mean, 2 final) against ω̄."""
+    w = points[:, 0]
+    return float(w @ points[:, column] / (w @ w))
+
+
+def summary_rows(lines):
+    rows = []
+    for d in sorted(lines):
+        pts = lines[d]
+        k_mean, k_final = slope(pts, 1), slope(pts, 2)
+        red = 100 * (1 - k_mean / slope(lines[np.inf], 1))
+        red_final = 100 * (1 - k_final / slope(lines[np.inf], 2))
+        rows.append([f"{d:g}", len(pts), " ".join(f"{w:g}" for w in pts[:, 0]), f"{k_mean:.6g}",
+                     f"{red:.1f}", PAPER_REDUCTION.get(d, ""), f"{k_final:.6g}", f"{red_final:.1f}"])
+    return rows
 
 
 def plot():
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    single_dir = os.path.join(OUT, "fig8_single")
-    single, _ = analyze(single_dir)
-    pairs, _ = analyze(os.path.join(OUT, "fig7c3"), "--single", single_dir)
-    far, _ = analyze(os.path.join(OUT, "fig8b"), "--single", single_dir)
     fig, (ax_a, ax_b) = plt.subplots(1, 2, figsize=(10, 4))
-    series = {}
-    for r in completed(single):
-        series.setdefault(np.inf, []).append((float(r["omega_bar"]), 2 * float(r["propulsive_force_bar_mean"])))
-    for r in completed(pairs):
-        d = round(first_number(r["rods.2.base"]) / R, 6)
-        if d in (4, 6, 8):
-            series.setdefault(d, []).append((float(r["omega_bar"]), float(r["propulsive_force_bar_mean"])))
-    slopes = {}
-    lines = ["delta_t_over_R,points,slope_through_origin,reduction_percent,paper_reduction_percent,"
-             "mean_ratio_to_two_singles"]
-    for d in sorted(series):
-        pts = np.array(sorted(series[d]))
-        w, f = pts[:, 0], pts[:, 1]
-        slopes[d] = float(w @ f / (w @ w))
-        ax_a.plot(w, f, "o", ms=4, label=f"Δt/R = {d:g}")
-        ax_a.plot([0, w.max()], [0, slopes[d] * w.max()], "-", lw=1, color=ax_a.lines[-1].get_color())
-    single_by_w = {float(r["omega_bar"]): float(r["propulsive_force_bar_mean"]) for r in completed(single)}
-    for d in sorted(series):
-        pts = np.array(sorted(series[d]))
-        red = 100 * (1 - slopes[d] / slopes[np.inf]) if np.inf in slopes else np.nan
-        ratios = [f / (2 * single_by_w[w]) for w, f in pts if w in single_by_w]
-        lines.append(f"{d:g},{len(pts)},{slopes[d]:.6g},{red:.1f},{PAPER_REDUCTION.get(d, '')},"
-                     f"{np.mean(ratios) if ratios else np.nan:.4f}")
+    lines = series()
+    for d in sorted(lines):
+        pts = lines[d]
+        k = slope(pts, 1)
+        ax_a.plot(pts[:, 0], pts[:, 1], "o", ms=4, label=f"Δt/R = {d:g}")
+        ax_a.plot([0, pts[:, 0].max()], [0, k * pts[:, 0].max()], "-", lw=1, color=ax_a.lines[-1].get_color())
     ax_a.set_xlabel("ω̄")
     ax_a.set_ylabel("F̄p (mean over t̄ ∈ [1, 2])")
     ax_a.legend(fontsize=8)
     ax_a.set_title("(a) two flagella; ∞ = twice one flagellum", fontsize=9)
-    b_rows = sorted((first_number(r["rods.2.base"]) / R, float(r["propulsive_force_ratio_to_single"]))
-                    for r in completed(far) if r["propulsive_force_ratio_to_single"])
-    lines.append("")
-    lines.append("fig8b_delta_t_over_R,Fp_over_Fp_single")
-    for d, ratio in b_rows:
-        lines.append(f"{d:g},{ratio:.4f}")
-    if b_rows:
-        ax_b.semilogx([d for d, _ in b_rows], [x for _, x in b_rows], "o-", ms=4)
+    far = [(float(r["delta_t_over_R"]), float(r["propulsive_force_ratio_to_single"])) for r in read_csv(FAR)]
+    if far:
+        ax_b.semilogx([d for d, _ in far], [x for _, x in far], "o-", ms=4)
     ax_b.axhline(2, color="k", lw=0.5, ls="--")
     ax_b.set_xlabel("Δt / R")
-    ax_b.set_ylabel("F̄p / F̄p single")
+    ax_b.set_ylabel("F̄p / F̄p single (means over t̄ ∈ [1, 2])")
     ax_b.set_title("(b) ω̄ = 213", fontsize=9)
     fig.tight_layout()
     fig.savefig(os.path.join(DOCS, "fig8_propulsion.png"), dpi=110)
-    with open(os.path.join(DOCS, "fig8_propulsion.csv"), "w") as f:
-        f.write("\n".join(lines) + "\n")
-    log("\n".join(lines))
+    log(open(SUMMARY).read())
 
 
 def main():
-    sweep_study_main(["examples/studies/fig8a_single.toml", "examples/studies/fig8b_distance.toml"], plot)
+    sweep_study_main(["examples/studies/fig8a_single.toml", "examples/studies/fig8b_distance.toml"], table, plot)
 
 
 if __name__ == "__main__":

@@ -1,5 +1,6 @@
 // `stokesrods sweep` as users run it: cases in separate processes, failure isolation, resume after
-// a finished or an interrupted sweep, bad sweep files, and the same sweep under mpirun -n 2.
+// a finished or an interrupted sweep, the [refine] bisection, bad sweep files, and the same sweep
+// under mpirun -n 2.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -136,6 +137,43 @@ TEST(SweepCli, BadSweepFileIsExitTwoNamingFileAndKey) {
   EXPECT_NE(o.err.find("s.toml"), std::string::npos) << o.err;
   EXPECT_NE(o.err.find("omega_barr"), std::string::npos) << o.err;
   EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
+// The [refine] pass end to end. Two identical helices side by side along y, rod 1's helix radius
+// varied: their tips have the same x (Δb = 0) exactly where rod 1's radius equals rod 2's, 5.9 mm.
+// Over [5, 10] mm, Δb > 0 below and < 0 above (the tips' x is set by the geometry; two 10 ms steps
+// move them by ~1e-5 R). Bisection to 1 mm: 7.5 (crossed), 6.25 (crossed), 5.625 (not), then
+// (5.625, 6.25] is narrower than the resolution and the sweep stops.
+TEST(SweepCli, TheRefinePassBisectsTheLineToTheResolution) {
+  const fs::path dir = Dir("refine");
+  std::ofstream(dir / "pair.toml") << "[run]\nduration = 0.02\ntime_step = 0.01\nframes = false\n"
+                                   << "[fluid]\nmodel = \"rss\"\n[[rods]]\nnodes = 11\n[[rods]]\n"
+                                   << "nodes = 11\nbase = [0.0, 0.05, 0.0]\nhelix_radius = 0.0059\n";
+  std::ofstream(dir / "s.toml") << "base = \"pair.toml\"\noutput = \"" << (dir / "out").string()
+                                << "\"\n[vary]\n\"rods.1.helix_radius\" = [0.005, 0.01]\n[refine]\n"
+                                << "key = \"rods.1.helix_radius\"\ncriterion = \"crossed\"\n"
+                                << "resolution = 0.001\n";
+  const Outcome o = Shell(dir, Sweep(dir / "s.toml"));
+  ASSERT_EQ(o.code, 0) << o.err;
+  std::vector<std::string> radii;
+  for (const auto& row : ReadCsv(dir / "out" / "sweep.csv")) {
+    EXPECT_EQ(row.at("status"), "completed");
+    radii.push_back(row.at("rods.1.helix_radius"));
+  }
+  EXPECT_EQ(radii, (std::vector<std::string>{"0.005", "0.01", "0.0075", "0.00625", "0.005625"}));
+  ASSERT_EQ(Shell(dir, std::string(STOKESRODS_BINARY) + " analyze " + (dir / "out").string()).code, 0);
+  const auto lines = ReadCsv(dir / "out" / "critical.csv");
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_EQ(lines[0].at("below"), "0.005625");
+  EXPECT_EQ(lines[0].at("above"), "0.00625");
+  EXPECT_EQ(lines[0].at("monotone"), "1");
+  // A rerun finds the refinement's cases again (by their names) and runs none of them.
+  const fs::path last = dir / "out" / "rod1.helix_radius=0.005625" / "summary.json";
+  const auto stamp = fs::last_write_time(last);
+  const Outcome again = Shell(dir, Sweep(dir / "s.toml"));
+  EXPECT_EQ(again.code, 0) << again.err;
+  EXPECT_EQ(ReadCsv(dir / "out" / "sweep.csv").size(), 5u);
+  EXPECT_EQ(fs::last_write_time(last), stamp);
 }
 
 #ifdef STOKESRODS_MPIEXEC

@@ -3,6 +3,7 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -146,6 +147,31 @@ TEST(Sweep, ARerunSkipsOnlyCasesMadeFromTheSameConfiguration) {
   EXPECT_EQ(ReadCaseRecord(s, c).status, "pending");  // no checkpoint: start again
   std::ofstream(fs::path(c.output_dir) / "checkpoint.bin") << "x";
   EXPECT_TRUE(ReadCaseRecord(s, c).resumable);
+}
+
+// The study sweeps users run (examples/studies): every case is a valid configuration, and Fig. 9's
+// cases keep what its file promises (Δt/R = 4, the representative helix's edge length).
+TEST(Sweep, TheStudySweepsExpandIntoValidCases) {
+  const fs::path studies = fs::path(STOKESRODS_SOURCE_DIR) / "examples" / "studies";
+  int files = 0;
+  for (const auto& entry : fs::directory_iterator(studies)) {
+    if (entry.path().extension() != ".toml") continue;
+    ++files;
+    const Sweep s = LoadSweep(entry.path().string(), (Dir() / "studies").string());
+    EXPECT_GT(s.cases.size(), 1u) << entry.path();
+    for (const SweepCase& c : s.cases) EXPECT_NO_THROW(LoadConfig(s.base, c.overrides)) << c.name;
+  }
+  EXPECT_GE(files, 6);
+  const Sweep fig9 = LoadSweep((studies / "fig9_pitch_radius.toml").string(), (Dir() / "fig9").string());
+  const double kEdge = 0.2 * std::hypot(1.0, 2.0 * M_PI * 0.01 / 0.05) / 64.0;  // N = 65
+  for (const SweepCase& c : fig9.cases) {
+    const Config config = LoadConfig(fig9.base, c.overrides);
+    const RodConfig& rod = config.rods[0];
+    EXPECT_DOUBLE_EQ(config.rods[1].base.x(), 4.0 * rod.helix_radius) << c.name;
+    EXPECT_EQ(config.rods[1].nodes, rod.nodes) << c.name;
+    const double arc = rod.axis_length * std::hypot(1.0, 2.0 * M_PI * rod.helix_radius / rod.pitch);
+    EXPECT_NEAR(arc / (rod.nodes - 1), kEdge, 0.02 * kEdge) << c.name;
+  }
 }
 
 }  // namespace
