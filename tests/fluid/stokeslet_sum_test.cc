@@ -11,6 +11,10 @@
 #include <cstdio>
 #include <random>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include "stokesrods/fluid/stokeslet_segment.h"
 
 namespace stokesrods {
@@ -237,6 +241,35 @@ TEST(StokesletSumTest, SinglePrecisionDirectSumIsWellWithinItsTolerance) {
     std::printf("single precision, %ld sources: error %.2e\n", static_cast<long>(c.sources.cols()), error);
     EXPECT_LT(error, 0.1 * kSinglePrecisionTolerance);
   }
+}
+
+
+// A run resumes bit for bit on another thread count (tests/reliability/kill_resume.py), so the
+// fast sum's result must not depend on it: OpenMP splits only independent boxes (here 1 against 2
+// OpenMP threads), and the BLAS runs on one thread of its own (tests/solver: Blas.RunsOnOneThread…).
+TEST(StokesletSumTest, ResultDoesNotDependOnTheThreadCount) {
+#ifdef _OPENMP
+  std::mt19937 rng(3);
+  const Cloud c = HelixLattice(6, 6);
+  StokesletSumOptions options;
+  options.tolerance = 1e-4;
+  options.direct_below_pairs = 0;
+  options.choose_by_cost = false;
+  const Matrix3X g = RandomStrengths(static_cast<int>(c.sources.cols()), &rng);
+  Matrix3X w[2];
+  const int saved = omp_get_max_threads();
+  for (int threads = 1; threads <= 2; ++threads) {
+    omp_set_num_threads(threads);
+    auto fast = MakeFastStokesletSum(options);
+    fast->Build(c.sources, c.regularization, c.targets);
+    ASSERT_GT(fast->Stats().far_pairs, 0);  // the tree, not the direct fallback
+    fast->Apply(g, &w[threads - 1]);
+  }
+  omp_set_num_threads(saved);
+  EXPECT_TRUE(w[0] == w[1]);
+#else
+  GTEST_SKIP() << "built without OpenMP";
+#endif
 }
 
 }  // namespace

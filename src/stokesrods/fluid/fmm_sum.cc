@@ -39,6 +39,7 @@
 #include "stokesrods/fluid/fmm_tree.h"
 #include "stokesrods/fluid/point_stokeslet.h"
 #include "stokesrods/fluid/stokeslet_sum.h"
+#include "stokesrods/solver/blas.h"
 
 namespace stokesrods {
 namespace {
@@ -54,9 +55,11 @@ extern "C" void dgemm_(const char* transa, const char* transb, const int* m, con
                        const double* b, const int* ldb, const double* beta, double* c,
                        const int* ldc);
 
-/// c = alpha op(a) b + beta c by the BLAS (OpenBLAS: its kernels for the CPU at hand, and its
-/// threads; the build itself targets baseline x86-64, where Eigen's products are 5–10× slower).
+/// c = alpha op(a) b + beta c by the BLAS (OpenBLAS: its kernels for the CPU at hand, on one
+/// thread so that the result does not depend on the thread count (solver/blas.h); the build
+/// itself targets baseline x86-64, where Eigen's products are 5–10× slower).
 void Gemm(const MatX& a, bool transpose_a, const MatX& b, double alpha, double beta, MatX* c) {
+  SR_ASSERT(BlasIsSingleThreaded(), "the BLAS must run on one thread");
   const int m = static_cast<int>(transpose_a ? a.cols() : a.rows());
   const int n = static_cast<int>(b.cols()), k = static_cast<int>(b.rows());
   if (beta == 0.0) c->resize(m, n);
@@ -293,7 +296,7 @@ void FmmStokesletSum::Downward() const {
 }
 
 // The V-list translations of a level into the downward check potentials, batched by offset into
-// one matrix–matrix product each (threaded by the BLAS).
+// one matrix–matrix product each (the BLAS on one thread: see Gemm).
 void FmmStokesletSum::M2l(int level) const {
   const auto& pairs = m2l_pairs_[static_cast<size_t>(level)];
   const MatX& up = up_[static_cast<size_t>(level)];

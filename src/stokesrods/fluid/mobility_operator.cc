@@ -9,6 +9,7 @@
 #include "stokesrods/fluid/rss.h"
 #include "stokesrods/fluid/rss_rows.h"
 #include "stokesrods/fluid/stokeslet_segment.h"
+#include "stokesrods/solver/blas.h"
 
 namespace stokesrods {
 
@@ -36,7 +37,7 @@ class DenseMobility final : public MobilityOperator {
 #pragma omp parallel for schedule(static) if (n > 2 * kRows)
     for (Eigen::Index first = 0; first < n; first += kRows) {
       const Eigen::Index rows = std::min(kRows, n - first);
-      velocity->segment(first, rows).noalias() = matrix_.middleRows(first, rows) * force;
+      GemvRows(matrix_, first, rows, force.data(), velocity->data() + first);
     }
   }
   MatX SelfBlock(int rod) const override {

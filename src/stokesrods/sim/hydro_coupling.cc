@@ -5,28 +5,12 @@
 
 #include "stokesrods/common/assert.h"
 #include "stokesrods/sim/state.h"
+#include "stokesrods/solver/blas.h"
 #include "stokesrods/solver/gmres.h"
-
-extern "C" void sgemv_(const char* trans, const int* m, const int* n, const float* alpha,
-                       const float* a, const int* lda, const float* x, const int* incx,
-                       const float* beta, float* y, const int* incy);
 
 namespace stokesrods {
 
 namespace {
-
-// y = A x by the BLAS (OpenBLAS: vectorized for the CPU at hand and threaded; the build targets
-// baseline x86-64, where Eigen's product would use SSE2 only). Memory bound at these sizes.
-void Gemv(const Eigen::MatrixXf& a, const Eigen::VectorXf& x, Eigen::VectorXf* y) {
-  const int m = static_cast<int>(a.rows()), n = static_cast<int>(a.cols()), one = 1;
-  const float alpha = 1.0f, beta = 0.0f;
-  y->resize(m);
-  if (m == 0 || n == 0) {
-    y->setZero();
-    return;
-  }
-  sgemv_("N", &m, &n, &alpha, a.data(), &m, x.data(), &one, &beta, y->data(), &one);
-}
 
 // t = Σ_j over n points of (1/R + ε_j²/R³, then r rᵀ/R³ as xx, xy, xz, yy, yz, zz),
 // r = p − x_j, R² = |r|² + ε_j²: the point Stokeslets S_ε of a chunk of nodes at p, summed.
@@ -169,10 +153,10 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
     BuildSchurBlocks(model);
     if (block_preconditioner_) {
       std::vector<MatX> blocks(model.rods.size());
-      block_lu_.clear();
+      block_lu_.assign(model.rods.size(), DenseLu<float>());
       for (std::size_t r = 0; r < model.rods.size(); ++r) {
         blocks[r] = h * mobility_->SelfBlock(static_cast<int>(r)) + sx_blocks_[r];
-        block_lu_.emplace_back(blocks[r]);
+        if (!block_lu_[r].Compute(blocks[r].cast<float>())) return have_preconditioner_ = false;
       }
       BuildCoarseLevel(model, h, blocks);
     } else {
@@ -181,10 +165,12 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
         const int first = 3 * model.rods[r].node_offset, n = static_cast<int>(sx_blocks_[r].rows());
         capacitance.block(first, first, n, n) += sx_blocks_[r];
       }
-      if (krylov_)
-        capacitance_lu_float_.compute(capacitance.cast<float>());
-      else
+      if (krylov_) {
+        if (!capacitance_lu_float_.Compute(capacitance.cast<float>()))
+          return have_preconditioner_ = false;
+      } else {
         capacitance_lu_.compute(capacitance);
+      }
     }
   }
   mobility_changed_ = false;
@@ -298,7 +284,9 @@ void HydroCoupling::BuildCoarseLevel(const Model& model, double h,
 
 void HydroCoupling::Precondition(const VecX& v, VecX* out) const {
   if (!block_preconditioner_) {
-    *out = capacitance_lu_float_.solve(v.cast<float>()).cast<double>();
+    Eigen::VectorXf x = v.cast<float>();
+    capacitance_lu_float_.Solve(&x);
+    *out = x.cast<double>();
     return;
   }
   // Coarse: c = E⁻¹ Zᵀ v; then the blocks on what the coarse correction leaves, y = Zc + D⁻¹(v − Wc).
@@ -315,7 +303,9 @@ void HydroCoupling::Precondition(const VecX& v, VecX* out) const {
   for (int r = 0; r < mobility_->num_rods(); ++r) {
     const int first = 3 * mobility_->node_offset(r);
     const int n = 3 * (mobility_->node_offset(r + 1) - mobility_->node_offset(r));
-    out->segment(first, n) = block_lu_[static_cast<size_t>(r)].solve(rest.segment(first, n));
+    Eigen::VectorXf x = rest.segment(first, n).cast<float>();
+    block_lu_[static_cast<size_t>(r)].Solve(&x);
+    out->segment(first, n) = x.cast<double>();
   }
   for (int a = 0; a < nc; ++a)
     for (int i = chunk_first_[static_cast<size_t>(a)]; i < chunk_first_[static_cast<size_t>(a) + 1]; ++i)

@@ -33,6 +33,7 @@
 #include "stokesrods/sim/forces.h"
 #include "stokesrods/sim/model.h"
 #include "stokesrods/solver/banded_matrix.h"
+#include "stokesrods/solver/dense_lu.h"
 
 namespace stokesrods {
 
@@ -107,9 +108,9 @@ class HydroCoupling {
   std::vector<MatX> sx_blocks_;    ///< S_k B_k⁻¹ S_kᵀ (3N_k × 3N_k), for the preconditioner only
   // Direct: the LU of C; krylov: the preconditioner (the LU of C in single precision — a
   // preconditioner needs no more, and its solves stream half the memory —, or two levels).
-  Eigen::PartialPivLU<MatX> capacitance_lu_;
-  Eigen::PartialPivLU<Eigen::MatrixXf> capacitance_lu_float_;
-  std::vector<Eigen::PartialPivLU<MatX>> block_lu_;
+  Eigen::PartialPivLU<MatX> capacitance_lu_;  ///< direct: the reference, Eigen's own LU
+  DenseLu<float> capacitance_lu_float_;
+  std::vector<DenseLu<float>> block_lu_;      ///< the per-rod blocks D_k (single precision)
   void BuildCoarseLevel(const Model& model, double h, const std::vector<MatX>& blocks);
   std::vector<int> chunk_first_;   ///< first global node of each chunk; back() = M
   Eigen::MatrixXf coarse_w_;       ///< W ≈ C Z (3M × 3 chunks), single precision (a

@@ -1,0 +1,56 @@
+#include "stokesrods/solver/blas.h"
+
+extern "C" {
+void sgemv_(const char* trans, const int* m, const int* n, const float* alpha, const float* a,
+            const int* lda, const float* x, const int* incx, const float* beta, float* y,
+            const int* incy, std::size_t trans_len);
+void dgemv_(const char* trans, const int* m, const int* n, const double* alpha, const double* a,
+            const int* lda, const double* x, const int* incx, const double* beta, double* y,
+            const int* incy, std::size_t trans_len);
+}
+
+// OpenBLAS's own threads split its products and factorizations differently for each thread
+// count, so their results would depend on it in the last bits (measured: dgemv of 390 × 390, sgetrf
+// of 390 … 4000 differ between 1 and 2 threads), and a run could not resume bit for bit on
+// another thread count (tests/reliability/kill_resume.py). The BLAS therefore runs on one thread
+// of its own; our parallelism is OpenMP over independent pieces. Weak: absent with another BLAS.
+extern "C" void openblas_set_num_threads(int) __attribute__((weak));
+
+namespace stokesrods {
+namespace {
+
+const bool kBlasOnOneThread = [] {
+  if (openblas_set_num_threads) openblas_set_num_threads(1);
+  return true;
+}();
+
+}  // namespace
+
+bool BlasIsSingleThreaded() { return kBlasOnOneThread; }
+
+void Gemv(const Eigen::MatrixXf& a, const Eigen::VectorXf& x, Eigen::VectorXf* y) {
+  const int m = static_cast<int>(a.rows()), n = static_cast<int>(a.cols()), one = 1;
+  const float alpha = 1.0f, beta = 0.0f;
+  y->resize(m);
+  if (m == 0) return;
+  if (n == 0) {
+    y->setZero();
+    return;
+  }
+  sgemv_("N", &m, &n, &alpha, a.data(), &m, x.data(), &one, &beta, y->data(), &one, 1);
+}
+
+void GemvRows(const Eigen::MatrixXd& a, Eigen::Index first, Eigen::Index rows, const double* x,
+              double* y) {
+  const int m = static_cast<int>(rows), n = static_cast<int>(a.cols());
+  const int lda = static_cast<int>(a.rows()), one = 1;
+  const double alpha = 1.0, beta = 0.0;
+  if (m == 0) return;
+  if (n == 0) {
+    for (int i = 0; i < m; ++i) y[i] = 0.0;
+    return;
+  }
+  dgemv_("N", &m, &n, &alpha, a.data() + first, &lda, x, &one, &beta, y, &one, 1);
+}
+
+}  // namespace stokesrods

@@ -1,0 +1,20 @@
+// y = A x by the BLAS (OpenBLAS: vectorized for the CPU at hand). The build targets baseline
+// x86-64, where Eigen's own products use SSE2 only; these are the products that matter.
+#pragma once
+
+#include <Eigen/Core>
+
+namespace stokesrods {
+
+/// True once the BLAS is set to one thread of its own (done when this library is loaded; see
+/// blas.cc: results must not depend on the thread count). Callers of the BLAS reference it so
+/// that the setting is linked in.
+bool BlasIsSingleThreaded();
+
+/// y = A x (y resized).
+void Gemv(const Eigen::MatrixXf& a, const Eigen::VectorXf& x, Eigen::VectorXf* y);
+/// y = A x for a block of rows of a column-major matrix: rows [first, first + rows) of `a`.
+void GemvRows(const Eigen::MatrixXd& a, Eigen::Index first, Eigen::Index rows, const double* x,
+              double* y);
+
+}  // namespace stokesrods

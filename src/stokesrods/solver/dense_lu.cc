@@ -1,0 +1,58 @@
+#include "stokesrods/solver/dense_lu.h"
+
+#include <utility>
+
+#include "stokesrods/common/assert.h"
+
+extern "C" {
+void sgetrf_(const int* m, const int* n, float* a, const int* lda, int* ipiv, int* info);
+void dgetrf_(const int* m, const int* n, double* a, const int* lda, int* ipiv, int* info);
+void sgetrs_(const char* trans, const int* n, const int* nrhs, const float* a, const int* lda,
+             const int* ipiv, float* b, const int* ldb, int* info, std::size_t trans_len);
+void dgetrs_(const char* trans, const int* n, const int* nrhs, const double* a, const int* lda,
+             const int* ipiv, double* b, const int* ldb, int* info, std::size_t trans_len);
+}
+
+namespace stokesrods {
+namespace {
+
+void Getrf(int n, float* a, int* ipiv, int* info) { sgetrf_(&n, &n, a, &n, ipiv, info); }
+void Getrf(int n, double* a, int* ipiv, int* info) { dgetrf_(&n, &n, a, &n, ipiv, info); }
+void Getrs(int n, const float* a, const int* ipiv, float* b, int* info) {
+  const int one = 1;
+  sgetrs_("N", &n, &one, a, &n, ipiv, b, &n, info, 1);
+}
+void Getrs(int n, const double* a, const int* ipiv, double* b, int* info) {
+  const int one = 1;
+  dgetrs_("N", &n, &one, a, &n, ipiv, b, &n, info, 1);
+}
+
+}  // namespace
+
+template <typename Scalar>
+bool DenseLu<Scalar>::Compute(Matrix a) {
+  SR_ASSERT(a.rows() == a.cols(), "DenseLu: the matrix must be square");
+  lu_ = std::move(a);
+  const int n = static_cast<int>(lu_.rows());
+  pivots_.resize(static_cast<std::size_t>(n));
+  if (n == 0) return true;
+  int info = 0;
+  Getrf(n, lu_.data(), pivots_.data(), &info);
+  SR_ASSERT(info >= 0, "DenseLu: bad argument to getrf");
+  return info == 0;
+}
+
+template <typename Scalar>
+void DenseLu<Scalar>::Solve(Vector* b) const {
+  SR_ASSERT(b->size() == lu_.rows(), "DenseLu: right-hand side of the wrong size");
+  const int n = static_cast<int>(lu_.rows());
+  if (n == 0) return;
+  int info = 0;
+  Getrs(n, lu_.data(), pivots_.data(), b->data(), &info);
+  SR_ASSERT(info == 0, "DenseLu: bad argument to getrs");
+}
+
+template class DenseLu<float>;
+template class DenseLu<double>;
+
+}  // namespace stokesrods
