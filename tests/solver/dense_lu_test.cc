@@ -57,7 +57,9 @@ TEST(DenseLu, ReportsASingularMatrix) {
 extern "C" int openblas_get_num_threads() __attribute__((weak));
 TEST(Blas, RunsOnOneThreadOfItsOwn) {
   EXPECT_TRUE(BlasIsSingleThreaded());
-  if (openblas_get_num_threads) EXPECT_EQ(openblas_get_num_threads(), 1);
+  if (openblas_get_num_threads) {
+    EXPECT_EQ(openblas_get_num_threads(), 1);
+  }
 }
 
 TEST(Blas, ProductsMatchEigen) {

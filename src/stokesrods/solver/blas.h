@@ -11,10 +11,12 @@ namespace stokesrods {
 /// that the setting is linked in.
 bool BlasIsSingleThreaded();
 
-/// y = A x (y resized).
+/// y = A x (y resized), rows in blocks over the OpenMP threads (the BLAS itself runs on one).
 void Gemv(const Eigen::MatrixXf& a, const Eigen::VectorXf& x, Eigen::VectorXf* y);
 /// y = A x for a block of rows of a column-major matrix: rows [first, first + rows) of `a`.
 void GemvRows(const Eigen::MatrixXd& a, Eigen::Index first, Eigen::Index rows, const double* x,
               double* y);
+void GemvRows(const Eigen::MatrixXf& a, Eigen::Index first, Eigen::Index rows, const float* x,
+              float* y);
 
 }  // namespace stokesrods
