@@ -116,8 +116,8 @@ class FmmStokesletSum final : public StokesletSum {
   // M2L pairs (target box, source box) per level and offset, in the order of the target boxes, and
   // their products' scratch.
   std::vector<std::array<std::vector<std::pair<int, int>>, 343>> m2l_pairs_;
-  mutable MatX m2l_in_, m2l_out_;
-  mutable Eigen::MatrixXf m2l_in_f_, m2l_out_f_;
+  mutable std::vector<MatX> m2l_out_;  // per offset of a level
+  mutable std::vector<Eigen::MatrixXf> m2l_out_f_;
   mutable std::vector<MatX> up_, check_, down_;  // per level: 3n × boxes
   StokesletSumStats stats_;
 };
@@ -298,27 +298,49 @@ void FmmStokesletSum::Downward() const {
 // The V-list translations of a level into the downward check potentials, batched by offset into
 // one matrix–matrix product each (the BLAS on one thread: see Gemm).
 void FmmStokesletSum::M2l(int level) const {
+  // The products of all offsets in parallel (OpenMP; the BLAS runs on one thread), each into its
+  // own output, then added to the check potentials in offset order: the same sums on any number
+  // of threads.
   const auto& pairs = m2l_pairs_[static_cast<size_t>(level)];
   const MatX& up = up_[static_cast<size_t>(level)];
   MatX& check = check_[static_cast<size_t>(level)];
   check.setZero();
-  for (int o = 0; o < 343; ++o) {
-    const auto& list = pairs[static_cast<size_t>(o)];
-    const auto m = static_cast<Eigen::Index>(list.size());
-    if (m == 0) continue;
-    if (single_) {
-      m2l_in_f_.resize(up.rows(), m);
-      for (Eigen::Index j = 0; j < m; ++j)
-        m2l_in_f_.col(j) = up.col(list[static_cast<size_t>(j)].second).cast<float>();
-      Gemm(M2lMatrixSingle(*op_, o), M2lIsTransposed(o), m2l_in_f_, &m2l_out_f_);
-      for (Eigen::Index j = 0; j < m; ++j)
-        check.col(list[static_cast<size_t>(j)].first) += m2l_out_f_.col(j).cast<double>();
-      continue;
+  std::vector<int> offsets;
+  for (int o = 0; o < 343; ++o)
+    if (!pairs[static_cast<size_t>(o)].empty()) offsets.push_back(o);
+  const auto count = static_cast<int>(offsets.size());
+  m2l_out_.resize(static_cast<size_t>(count));
+  m2l_out_f_.resize(static_cast<size_t>(count));
+#pragma omp parallel
+  {
+    MatX in;
+    Eigen::MatrixXf in_f;
+#pragma omp for schedule(dynamic, 1)
+    for (int i = 0; i < count; ++i) {
+      const int o = offsets[static_cast<size_t>(i)];
+      const auto& list = pairs[static_cast<size_t>(o)];
+      const auto m = static_cast<Eigen::Index>(list.size());
+      if (single_) {
+        in_f.resize(up.rows(), m);
+        for (Eigen::Index j = 0; j < m; ++j)
+          in_f.col(j) = up.col(list[static_cast<size_t>(j)].second).cast<float>();
+        Gemm(M2lMatrixSingle(*op_, o), M2lIsTransposed(o), in_f, &m2l_out_f_[static_cast<size_t>(i)]);
+      } else {
+        in.resize(up.rows(), m);
+        for (Eigen::Index j = 0; j < m; ++j) in.col(j) = up.col(list[static_cast<size_t>(j)].second);
+        Gemm(M2lMatrix(*op_, o), M2lIsTransposed(o), in, 1.0, 0.0, &m2l_out_[static_cast<size_t>(i)]);
+      }
     }
-    m2l_in_.resize(up.rows(), m);
-    for (Eigen::Index j = 0; j < m; ++j) m2l_in_.col(j) = up.col(list[static_cast<size_t>(j)].second);
-    Gemm(M2lMatrix(*op_, o), M2lIsTransposed(o), m2l_in_, 1.0, 0.0, &m2l_out_);
-    for (Eigen::Index j = 0; j < m; ++j) check.col(list[static_cast<size_t>(j)].first) += m2l_out_.col(j);
+  }
+  for (int i = 0; i < count; ++i) {
+    const auto& list = pairs[static_cast<size_t>(offsets[static_cast<size_t>(i)])];
+    for (std::size_t j = 0; j < list.size(); ++j) {
+      const auto col = static_cast<Eigen::Index>(j);
+      if (single_)
+        check.col(list[j].first) += m2l_out_f_[static_cast<size_t>(i)].col(col).cast<double>();
+      else
+        check.col(list[j].first) += m2l_out_[static_cast<size_t>(i)].col(col);
+    }
   }
 }
 
