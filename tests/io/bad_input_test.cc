@@ -7,6 +7,7 @@
 
 #include "stokesrods/io/build_model.h"
 #include "stokesrods/io/config.h"
+#include "common/model_from_toml.h"
 
 namespace stokesrods {
 namespace {
@@ -16,13 +17,7 @@ constexpr char kRod[] = "[[rods]]\nnodes = 21\naxis_length = 0.1\nhelix_radius =
 
 // The error of building the model and the run plan of `text`, or "" if both succeed.
 std::string ErrorOf(const std::string& text, const std::vector<std::string>& overrides = {}) {
-  try {
-    const Config config = ParseConfig(text, "case.toml", overrides);
-    MakeRunPlan(config, BuildModel(config));
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "";
+  return testing::ConfigErrorOf(text, overrides);
 }
 
 struct Case {

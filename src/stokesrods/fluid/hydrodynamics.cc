@@ -4,6 +4,7 @@
 #include "stokesrods/fluid/lsbt.h"
 #include "stokesrods/fluid/rft.h"
 #include "stokesrods/fluid/rss.h"
+#include "stokesrods/fluid/rss_wall.h"
 #include "stokesrods/fluid/stokeslet_segment.h"
 
 namespace stokesrods {
@@ -48,8 +49,12 @@ Eigen::Index TotalNodes(const std::vector<HydroRod>& rods) {
 void AssembleMobility(const FluidParams& params, const std::vector<HydroRod>& rods,
                       MatX* mobility) {
   SR_ASSERT(params.viscosity > 0.0, "viscosity must be > 0");
+  SR_ASSERT(!params.wall || params.model == FluidModel::kRss, "a wall needs the RSS model");
   switch (params.model) {
-    case FluidModel::kRss: AssembleRssMobility(params, rods, mobility); return;
+    case FluidModel::kRss:
+      AssembleRssMobility(params, rods, mobility);
+      if (params.wall) AddRssWallImages(params, rods, mobility);
+      return;
     case FluidModel::kLsbt: AssembleLsbtMobility(params, rods, mobility); return;
     case FluidModel::kRft: AssembleRftMobility(rods, mobility); return;
     case FluidModel::kNone: break;
@@ -60,7 +65,10 @@ void AssembleMobility(const FluidParams& params, const std::vector<HydroRod>& ro
 Vec3 FluidVelocityAt(const FluidParams& params, const std::vector<HydroRod>& rods,
                      const VecX& nodal_forces, const Vec3& point) {
   SR_ASSERT(params.model != FluidModel::kNone, "FluidVelocityAt: no fluid model");
-  if (params.model == FluidModel::kRss) return RssVelocityAt(params, rods, nodal_forces, point);
+  if (params.model == FluidModel::kRss)
+    return RssVelocityAt(params, rods, nodal_forces, point) +
+           (params.wall ? RssWallImageVelocityAt(params, rods, nodal_forces, point) : Vec3::Zero());
+  SR_ASSERT(!params.wall, "a wall needs the RSS model");
   SR_ASSERT(nodal_forces.size() == 3 * TotalNodes(rods), "force vector of the wrong size");
   Vec3 u = Vec3::Zero();
   Eigen::Index offset = 0;

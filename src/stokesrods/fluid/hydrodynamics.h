@@ -11,10 +11,12 @@
 //   rft : resistive force theory, local: F_i = Δl_i (c_∥ t tᵀ + c_⊥ (I − t tᵀ)) U_i.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "stokesrods/common/types.h"
+#include "stokesrods/fluid/wall.h"
 
 namespace stokesrods {
 
@@ -27,6 +29,8 @@ struct FluidParams {
   /// RSS assembly: relative error allowed on each far segment–node interaction (0: round-off,
   /// the reference; see StokesletSegment) [–].
   double far_field_tolerance = 0.0;
+  /// A plane no-slip wall (RSS only): every Stokeslet with its regularized images (wall.h).
+  std::optional<Wall> wall;
 };
 
 /// Geometry of one rod as the fluid sees it.
@@ -53,7 +57,7 @@ Eigen::Index TotalNodes(const std::vector<HydroRod>& rods);
 /// Nodal mobility 𝕄 (3M × 3M) of the model for the rods as they are now [m/(N·s)].
 /// kNone is a programmer error. RFT gives the block-diagonal inverse of its local resistance.
 ///   rss : 𝕄 = A Λ⁻¹ (rss.h), ε = params.regularization × the radius of the rod that owns the
-///         segment. 𝕄 is not symmetric (collocation of linear densities): solve it with LU, not
+///         segment; with params.wall, plus the images' part (rss_wall.h). 𝕄 is not symmetric (collocation of linear densities): solve it with LU, not
 ///         with a factorization that reads one triangle (LDLT, LLT).
 ///   lsbt: eq. C.2 (lsbt.h); symmetric but not positive definite at Δ = 2δ.
 ///   rft : rft.h.

@@ -12,8 +12,9 @@
 //                stokeslet_segment.h and stored as 3×3 blocks, or "far", integrated by a
 //                Gauss–Legendre rule whose point Stokeslets are summed by a fast summation
 //                (stokeslet_sum.h). O(M) memory.
-// Further sources of flow (cell bodies, wall images) extend the node set and the kernel behind the
-// same interface.
+// Further sources of flow extend the node set and the kernel behind the same interface: a wall's
+// images are in the kernel (FluidParams::wall, dense only), cell bodies' surface points follow
+// the rods' nodes in F and U (UpdateWithBodies, dense only).
 #pragma once
 
 #include <memory>
@@ -21,7 +22,9 @@
 
 #include <Eigen/LU>
 
+#include "stokesrods/common/assert.h"
 #include "stokesrods/fluid/hydrodynamics.h"
+#include "stokesrods/fluid/rigid_body.h"
 #include "stokesrods/fluid/stokeslet_sum.h"
 
 namespace stokesrods {
@@ -51,6 +54,13 @@ class MobilityOperator {
   virtual ~MobilityOperator() = default;
   /// Takes the geometry: 𝕄 = 𝕄(x) for the rods as they are now.
   virtual void Update(const std::vector<HydroRod>& rods) = 0;
+  /// The same with the bodies' surfaces (fluid/rigid_body.h), their P points after the rods' M
+  /// nodes in F and U: size() is 3(M + P). Operators without bodies take an empty list only.
+  virtual void UpdateWithBodies(const std::vector<HydroRod>& rods,
+                                const std::vector<BodySurface>& bodies) {
+    SR_ASSERT(bodies.empty(), "this mobility operator does not take bodies");
+    Update(rods);
+  }
   /// U = 𝕄 F (3M each) at the geometry of the last Update.
   virtual void Apply(const VecX& force, VecX* velocity) const = 0;
   /// The block of 𝕄 coupling rod k's nodes to themselves (3N_k × 3N_k), exact.
@@ -58,7 +68,7 @@ class MobilityOperator {
   /// The assembled 𝕄 when the operator holds one, else nullptr.
   virtual const MatX* matrix() const { return nullptr; }
 
-  int size() const { return 3 * static_cast<int>(node_offset_.back()); }
+  int size() const { return 3 * (node_offset_.back() + num_body_points_); }
   int num_rods() const { return static_cast<int>(node_offset_.size()) - 1; }
   /// First node of rod k among all nodes; node_offset(num_rods()) = M.
   int node_offset(int rod) const { return node_offset_[static_cast<size_t>(rod)]; }
@@ -66,6 +76,7 @@ class MobilityOperator {
  protected:
   void SetLayout(const std::vector<HydroRod>& rods);
   std::vector<int> node_offset_ = {0};
+  int num_body_points_ = 0;  ///< P (UpdateWithBodies)
 };
 
 /// Block-Jacobi approximation of 𝕄⁻¹ by the LU of each rod's self-mobility 𝕄_kk: the

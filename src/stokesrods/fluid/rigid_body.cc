@@ -6,6 +6,7 @@
 
 #include "stokesrods/common/assert.h"
 #include "stokesrods/fluid/rss.h"
+#include "stokesrods/fluid/rss_wall.h"
 #include "stokesrods/fluid/stokeslet_segment.h"
 
 namespace stokesrods {
@@ -39,10 +40,8 @@ MatX PointStokesletMobility(const BodySurface& surface, double viscosity, const 
   for (Eigen::Index j = 0; j < n; ++j)
     for (Eigen::Index i = 0; i < n; ++i)
       m.block<3, 3>(3 * i, 3 * j) =
-          scale * (wall ? RegularizedBlakeletMatrix(*wall, surface.points.col(i),
-                                                    surface.points.col(j), surface.regularization)
-                        : RegularizedStokesletMatrix(surface.points.col(i) - surface.points.col(j),
-                                                     surface.regularization));
+          scale * PointBlobMatrix(wall, surface.points.col(i), surface.points.col(j),
+                                  surface.regularization);
   return m;
 }
 
@@ -78,7 +77,7 @@ MatX AssembleMobilityWithBodies(const FluidParams& params, const std::vector<Hyd
   MatX m = MatX::Zero(3 * total, 3 * total);
   if (!rods.empty()) {
     MatX rod_block;
-    AssembleRssMobility(params, rods, &rod_block);
+    AssembleMobility(params, rods, &rod_block);  // with the wall's images if any
     m.topLeftCorner(3 * rod_nodes, 3 * rod_nodes) = rod_block;
   }
   const double scale = 1.0 / (8.0 * kPi * params.viscosity);
@@ -98,14 +97,16 @@ MatX AssembleMobilityWithBodies(const FluidParams& params, const std::vector<Hyd
     nodes.middleCols(k, rod.x->cols()) = *rod.x;
     k += rod.x->cols();
   }
-  // Body blobs at rod nodes and at body points.
+  // Body blobs at rod nodes and at body points (Blakelets with a wall).
+  const Wall* wall = params.wall ? &*params.wall : nullptr;
+#pragma omp parallel for schedule(static)
   for (Eigen::Index j = 0; j < points.cols(); ++j) {
     const Eigen::Index col = 3 * (rod_nodes + j);
     for (Eigen::Index i = 0; i < rod_nodes; ++i)
-      m.block<3, 3>(3 * i, col) = scale * RegularizedStokesletMatrix(nodes.col(i) - points.col(j), eps(j));
+      m.block<3, 3>(3 * i, col) = scale * PointBlobMatrix(wall, nodes.col(i), points.col(j), eps(j));
     for (Eigen::Index i = 0; i < points.cols(); ++i)
       m.block<3, 3>(3 * (rod_nodes + i), col) =
-          scale * RegularizedStokesletMatrix(points.col(i) - points.col(j), eps(j));
+          scale * PointBlobMatrix(wall, points.col(i), points.col(j), eps(j));
   }
   // Rod segments at body points: A_a f_a + A_b f_b with f = F/Λ (as in rss.cc).
   Eigen::Index first = 0;
@@ -121,7 +122,22 @@ MatX AssembleMobilityWithBodies(const FluidParams& params, const std::vector<Hyd
       }
     first += rod.x->cols();
   }
+  if (params.wall && !rods.empty())
+    for (Eigen::Index i = 0; i < points.cols(); ++i)
+      m.block(3 * (rod_nodes + i), 0, 3, 3 * rod_nodes) += RssWallImageRow(params, rods, points.col(i));
   return m;
+}
+
+Vec3 BodyBlobVelocityAt(const FluidParams& params, const std::vector<BodySurface>& bodies,
+                        const VecX& forces, const Vec3& point) {
+  const Wall* wall = params.wall ? &*params.wall : nullptr;
+  Vec3 u = Vec3::Zero();
+  Eigen::Index j = 0;
+  for (const BodySurface& b : bodies)
+    for (Eigen::Index i = 0; i < b.points.cols(); ++i, ++j)
+      u += PointBlobMatrix(wall, point, b.points.col(i), b.regularization) * forces.segment<3>(3 * j);
+  SR_ASSERT(forces.size() == 3 * j, "BodyBlobVelocityAt: forces of the wrong size");
+  return u / (8.0 * kPi * params.viscosity);
 }
 
 Vec6 RigidSwimmerVelocity(const FluidParams& params, const std::vector<HydroRod>& rods,

@@ -42,9 +42,15 @@ Mat6 RigidResistance(const BodySurface& surface, const Vec3& center, double visc
 
 /// 𝕄 over the rods' nodes (RSS, as AssembleMobility) followed by the bodies' points, with every
 /// coupling: rod segments at body points (eq. 8 with the rods' Voronoi lengths), body blobs at rod
-/// nodes and at each other's points (each blob with its own ε) [m/(N·s)]. RSS only.
+/// nodes and at each other's points (each blob with its own ε); with params.wall, every source
+/// with its images [m/(N·s)]. RSS only.
 MatX AssembleMobilityWithBodies(const FluidParams& params, const std::vector<HydroRod>& rods,
                                 const std::vector<BodySurface>& bodies);
+
+/// The velocity at `point` of the bodies' blobs carrying the forces F (3P, on the fluid, in the
+/// order of AssembleMobilityWithBodies), with params.wall's images if any [m/s].
+Vec3 BodyBlobVelocityAt(const FluidParams& params, const std::vector<BodySurface>& bodies,
+                        const VecX& forces, const Vec3& point);
 
 /// A rigid swimmer: one body and rigid rods fixed to it, the rods turned by a motor at rate ω
 /// [rad/s] about `motor_axis` (unit) through `motor_point`, relative to the body; no external

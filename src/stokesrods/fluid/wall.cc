@@ -35,6 +35,15 @@ Mat3 RegularizedBlakeletMatrix(const Wall& wall, const Vec3& x, const Vec3& x0,
 SegmentMobility StokesletSegmentNearWall(const Wall& wall, const Vec3& xa, const Vec3& xb,
                                          double regularization, const Vec3& point) {
   SegmentMobility out = StokesletSegment(xa, xb, regularization, point);
+  const SegmentMobility images = StokesletSegmentWallImages(wall, xa, xb, regularization, point);
+  out.a += images.a;
+  out.b += images.b;
+  return out;
+}
+
+SegmentMobility StokesletSegmentWallImages(const Wall& wall, const Vec3& xa, const Vec3& xb,
+                                           double regularization, const Vec3& point) {
+  SegmentMobility out;
   const Vec3 v = xb - xa;
   const double length = v.norm();
   // The mirrored segment and the target's distance to it.
@@ -56,6 +65,11 @@ SegmentMobility StokesletSegmentNearWall(const Wall& wall, const Vec3& xa, const
       out.b += w * alpha * image;
     }
   return out;
+}
+
+Mat3 PointBlobMatrix(const Wall* wall, const Vec3& x, const Vec3& x0, double regularization) {
+  return wall ? RegularizedBlakeletMatrix(*wall, x, x0, regularization)
+              : RegularizedStokesletMatrix(x - x0, regularization);
 }
 
 }  // namespace stokesrods

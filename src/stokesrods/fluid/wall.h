@@ -39,4 +39,13 @@ Mat3 RegularizedBlakeletMatrix(const Wall& wall, const Vec3& x, const Vec3& x0,
 SegmentMobility StokesletSegmentNearWall(const Wall& wall, const Vec3& xa, const Vec3& xb,
                                          double regularization, const Vec3& point);
 
+/// The images' part alone (StokesletSegmentNearWall minus StokesletSegment): what a wall adds to
+/// the free-space segment mobility.
+SegmentMobility StokesletSegmentWallImages(const Wall& wall, const Vec3& xa, const Vec3& xb,
+                                           double regularization, const Vec3& point);
+
+/// 8πμ times the mobility of a point blob at x0 seen at x: the regularized Stokeslet, or with a
+/// `wall` (may be null) the Blakelet above [1/m].
+Mat3 PointBlobMatrix(const Wall* wall, const Vec3& x, const Vec3& x0, double regularization);
+
 }  // namespace stokesrods

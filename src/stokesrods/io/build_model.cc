@@ -18,6 +18,7 @@
 #include "stokesrods/sim/contact_forces.h"
 #include "stokesrods/sim/observables.h"
 #include "stokesrods/sim/state.h"
+#include "stokesrods/io/build_bodies.h"
 
 namespace stokesrods {
 namespace {
@@ -200,6 +201,7 @@ Model BuildModel(const Config& config) {
   model.fluid.model = ParseFluidModel(config.fluid.model);
   model.fluid.viscosity = config.fluid.viscosity;
   model.fluid.regularization = config.fluid.regularization;
+  if (config.wall) model.fluid.wall = Wall{config.wall->point, config.wall->normal};
   model.coupling =
       config.fluid.coupling == "explicit" ? FluidCoupling::kExplicit : FluidCoupling::kImplicit;
   model.hydro.solver =
@@ -242,6 +244,7 @@ Model BuildModel(const Config& config) {
     SetRodOmega(&rod, omega);
     model.rods.push_back(std::move(rod));
   }
+  AddBodies(config, &model);
   FinalizeLayout(&model);
   // "auto": the dense 𝕄 (3M × 3M) while it is small, the matrix-free operator above 500 nodes.
   // Measured (docs/performance.md, one thread, h = 1 ms): 2 helices (130 nodes) 2.1 ms dense
@@ -250,7 +253,8 @@ Model BuildModel(const Config& config) {
   const bool matrix_free =
       config.fluid.mobility == "matrix_free" ||
       (config.fluid.mobility == "auto" && model.fluid.model == FluidModel::kRss &&
-       model.num_nodes > 500 && config.fluid.solver != "direct");
+       model.num_nodes > 500 && config.fluid.solver != "direct" && !config.wall &&
+       config.bodies.empty());  // bodies and walls: dense only (config_bodies.cc)
   model.hydro.mobility.kind = matrix_free ? MobilityKind::kMatrixFree : MobilityKind::kDense;
   // The dense 𝕄 of the Krylov path is assembled to the far-field tolerance (fewer Gauss points
   // far away); the direct solver, the reference, keeps round-off.
@@ -259,6 +263,7 @@ Model BuildModel(const Config& config) {
   CheckFluidModel(config, &model);
 
   CheckSelfOverlap(config, model);
+  CheckBodiesAndWall(config, model);
   // Rods overlapping at the start.
   std::vector<Eigen::AlignedBox3d> boxes;
   for (const RodModel& rod : model.rods) {

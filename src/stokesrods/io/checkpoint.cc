@@ -160,7 +160,7 @@ Checkpoint LoadCheckpoint(const std::string& path, const Model& model) {
   c.history.previous_q = r.Vector(model.num_dofs, "the previous q", true);
   c.history.previous_velocity = r.Vector(model.num_dofs, "the previous velocity", true);
   c.history.previous_h = r.Get<double>();
-  c.history.hydro_force = r.Vector(3 * model.num_nodes, "the drag", true);
+  c.history.hydro_force = r.Vector(3 * model.num_hydro_points(), "the drag", true);
   c.counters.newton_iterations = static_cast<long>(r.Get<std::int64_t>());
   c.counters.max_penetration = r.Get<double>();
   c.counters.step_reductions = static_cast<long>(r.Get<std::int64_t>());

@@ -8,6 +8,8 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include "stokesrods/io/config_fields.h"
+
 namespace stokesrods {
 
 ConfigError::ConfigError(const std::string& file, const std::string& key,
@@ -15,87 +17,6 @@ ConfigError::ConfigError(const std::string& file, const std::string& key,
     : std::runtime_error(fmt::format("{}: {}: {}", file, key.empty() ? "(file)" : key, problem)),
       file_(file),
       key_(key) {}
-
-// ---- The field lists: one per struct. -------------------------------------------------------
-
-template <class V>
-void VisitFields(RunConfig& c, V& v) {
-  v("name", c.name);
-  v("output", c.output);
-  v("mode", c.mode);
-  v("duration", c.duration);
-  v("t_bar_end", c.t_bar_end);
-  v("time_step", c.time_step);
-  v("integrator", c.integrator);
-  v("output_interval", c.output_interval);
-  v("frames", c.frames);
-  v("frames_format", c.frames_format);
-  v("checkpoint_interval", c.checkpoint_interval);
-  v("checkpoint_wall_interval", c.checkpoint_wall_interval);
-}
-template <class V>
-void VisitFields(FluidConfig& c, V& v) {
-  v("model", c.model);
-  v("viscosity", c.viscosity);
-  v("regularization", c.regularization);
-  v("coupling", c.coupling);
-  v("mobility", c.mobility);
-  v("far_field_tolerance", c.far_field_tolerance);
-  v("fast_sum_tolerance", c.fast_sum_tolerance);
-  v("solver", c.solver);
-  v("krylov_tolerance", c.krylov_tolerance);
-}
-template <class V>
-void VisitFields(ContactConfig& c, V& v) {
-  v("enabled", c.enabled);
-  v("tolerance", c.tolerance);
-  v("max_rounds", c.max_rounds);
-}
-template <class V>
-void VisitFields(GravityConfig& c, V& v) {
-  v("acceleration", c.acceleration);
-}
-template <class V>
-void VisitFields(SolverConfig& c, V& v) {
-  v("newton_tolerance", c.newton_tolerance);
-  v("newton_max_iterations", c.newton_max_iterations);
-  v("jacobian_max_age", c.jacobian_max_age);
-  v("damping", c.damping);
-  v("max_step_halvings", c.max_step_halvings);
-}
-template <class V>
-void VisitFields(FlowFieldConfig& c, V& v) {
-  v("times", c.times);
-  v("origin", c.origin);
-  v("u", c.u);
-  v("v", c.v);
-  v("resolution", c.resolution);
-}
-template <class V>
-void VisitFields(PointLoadConfig& c, V& v) {
-  v("node", c.node);
-  v("force", c.force);
-}
-template <class V>
-void VisitFields(RodConfig& c, V& v) {
-  v("shape", c.shape);
-  v("radius", c.radius);
-  v("young_modulus", c.young_modulus);
-  v("poisson_ratio", c.poisson_ratio);
-  v("density", c.density);
-  v("nodes", c.nodes);
-  v("axis_length", c.axis_length);
-  v("pitch", c.pitch);
-  v("helix_radius", c.helix_radius);
-  v("handedness", c.handedness);
-  v("lead_in", c.lead_in);
-  v("base", c.base);
-  v("clamped_nodes", c.clamped_nodes);
-  v("omega", c.omega);
-  v("omega_bar", c.omega_bar);
-  v("points", c.points);
-  v("loads", c.loads);
-}
 
 namespace {
 
@@ -268,6 +189,23 @@ void ReadSection(const toml::table& root, const char* name, const std::string& f
   reader.RejectUnknownKeys();
 }
 
+// [[name]] tables, each read as one S (messages name them name.K, K from 1).
+template <class S>
+void ReadTables(const toml::table& root, const char* name, const std::string& file,
+                std::vector<S>* out) {
+  const toml::node* node = root.get(name);
+  if (node == nullptr) return;
+  if (!node->is_array_of_tables())
+    throw ConfigError(file, name, fmt::format("expected [[{}]] tables", name));
+  for (std::size_t i = 0; i < node->as_array()->size(); ++i) {
+    S item;
+    Reader reader(node->as_array()->get(i)->as_table(), fmt::format("{}.{}", name, i + 1), file);
+    VisitFields(item, reader);
+    reader.RejectUnknownKeys();
+    out->push_back(std::move(item));
+  }
+}
+
 // The sections other than [[rods]], in the order show-config prints them.
 template <class F>
 void VisitSections(Config& c, F f) {
@@ -287,14 +225,16 @@ toml::table ToTable(Config& c) {
     VisitFields(s, w);
     root.insert_or_assign(name, std::move(t));
   });
-  toml::array rods;
-  for (RodConfig& r : c.rods) {
+  Writer w(&root);
+  w("rods", c.rods);
+  if (c.rods.empty()) root.insert_or_assign("rods", toml::array{});
+  w("bodies", c.bodies);
+  if (c.wall) {
     toml::table t;
-    Writer w(&t);
-    VisitFields(r, w);
-    rods.push_back(std::move(t));
+    Writer wall(&t);
+    VisitFields(*c.wall, wall);
+    root.insert_or_assign("wall", std::move(t));
   }
-  root.insert_or_assign("rods", std::move(rods));
   return root;
 }
 
@@ -368,6 +308,14 @@ std::string TomlText(Config& c) {
   for (RodConfig& rod : c.rods) {
     out += "\n[[rods]]\n";
     VisitFields(rod, writer);
+  }
+  for (BodyConfig& body : c.bodies) {
+    out += "\n[[bodies]]\n";
+    VisitFields(body, writer);
+  }
+  if (c.wall) {
+    out += "\n[wall]\n";
+    VisitFields(*c.wall, writer);
   }
   return out;
 }
@@ -462,21 +410,25 @@ void ApplyOverride(toml::table* root, const std::string& assignment, const std::
   }
   const toml::node_view<toml::node> value = parsed["v"];
   std::vector<std::string> path = Split(key, '.');
-  if (path.front() != "rods") {
+  const std::string list_name = path.front();  // [[rods]] and [[bodies]]: every one or one by K
+  if (list_name != "rods" && list_name != "bodies") {
     SetKey(root, path, 0, value, file, key);
     return;
   }
-  toml::array* rods = root->get_as<toml::array>("rods");
-  if (rods == nullptr || path.size() < 2) throw ConfigError(file, key, "no [[rods]] to set");
+  const std::string item = list_name == "rods" ? "rod" : "body";
+  toml::array* rods = root->get_as<toml::array>(list_name);
+  if (rods == nullptr || path.size() < 2)
+    throw ConfigError(file, key, fmt::format("no [[{}]] to set", list_name));
   const bool indexed = !path[1].empty() && path[1].find_first_not_of("0123456789") == std::string::npos;
   if (indexed) {
     // More digits than any rod count: out of range without overflowing the conversion.
     const std::size_t k = path[1].size() > 9 ? std::size_t(-1) : std::stoul(path[1]);
     if (k < 1 || k > rods->size())
-      throw ConfigError(file, key, fmt::format("rod {} does not exist (there are {})", path[1],
-                                               rods->size()));
+      throw ConfigError(file, key, fmt::format("{} {} does not exist (there are {})", item,
+                                               path[1], rods->size()));
     path.erase(path.begin(), path.begin() + 2);
-    if (path.empty()) throw ConfigError(file, key, "--set needs a key after the rod number");
+    if (path.empty())
+      throw ConfigError(file, key, fmt::format("--set needs a key after the {} number", item));
     SetKey(rods->get(k - 1)->as_table(), path, 0, value, file, key);
     return;
   }
@@ -502,29 +454,24 @@ Config ParseConfig(const std::string& toml_text, const std::string& file,
 
   Config config;
   config.file = file;
-  static const std::set<std::string> kSections = {"run",    "fluid",  "contact",   "gravity",
-                                                  "solver", "flow_field", "rods"};
+  static const std::set<std::string> kSections = {
+      "run", "fluid", "contact", "gravity", "solver", "flow_field", "rods", "bodies", "wall"};
   for (const auto& [key, node] : root)
     if (kSections.count(std::string(key.str())) == 0)
       throw ConfigError(file, std::string(key.str()),
                         "unknown section (known: run, fluid, contact, gravity, solver, "
-                        "flow_field, rods)");
+                        "flow_field, rods, bodies, wall)");
   ReadSection(root, "run", file, &config.run);
   ReadSection(root, "fluid", file, &config.fluid);
   ReadSection(root, "contact", file, &config.contact);
   ReadSection(root, "gravity", file, &config.gravity);
   ReadSection(root, "solver", file, &config.solver);
   ReadSection(root, "flow_field", file, &config.flow_field);
-  const toml::node* rods = root.get("rods");
-  if (rods == nullptr) throw ConfigError(file, "rods", "missing: at least one [[rods]] is required");
-  if (!rods->is_array_of_tables()) throw ConfigError(file, "rods", "expected [[rods]] tables");
-  for (std::size_t i = 0; i < rods->as_array()->size(); ++i) {
-    RodConfig rod;
-    Reader reader(rods->as_array()->get(i)->as_table(), fmt::format("rods.{}", i + 1), file);
-    VisitFields(rod, reader);
-    reader.RejectUnknownKeys();
-    config.rods.push_back(std::move(rod));
-  }
+  if (root.get("rods") == nullptr && root.get("bodies") == nullptr)
+    throw ConfigError(file, "rods", "missing: at least one [[rods]] (or [[bodies]]) is required");
+  ReadTables(root, "rods", file, &config.rods);
+  ReadTables(root, "bodies", file, &config.bodies);
+  if (root.get("wall") != nullptr) ReadSection(root, "wall", file, &config.wall.emplace());
   ValidateConfig(&config);
   return config;
 }
@@ -545,8 +492,14 @@ std::vector<ConfigKey> ListConfigKeys() {
     VisitFields(section, lister);
   });
   RodConfig rod;
-  KeyLister lister("rods", &keys);
-  VisitFields(rod, lister);
+  KeyLister rod_lister("rods", &keys);
+  VisitFields(rod, rod_lister);
+  BodyConfig body;
+  KeyLister body_lister("bodies", &keys);
+  VisitFields(body, body_lister);
+  WallConfig wall;
+  KeyLister wall_lister("wall", &keys);
+  VisitFields(wall, wall_lister);
   return keys;
 }
 

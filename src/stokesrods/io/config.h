@@ -107,6 +107,26 @@ struct RodConfig {
   std::optional<double> omega_bar;  ///< ω μ l0⁴ / EI
   std::vector<Vec3> points;         ///< shape = "points"
   std::vector<PointLoadConfig> loads;
+  /// The body (from 1) whose frame holds the clamped nodes and against which the motor turns;
+  /// 0: none (the clamp is fixed in space).
+  int body = 0;
+};
+
+/// A rigid cell body (SPEC "Additions"): its surface as regularized Stokeslets (fluid/rigid_body.h).
+struct BodyConfig {
+  std::string shape = "sphere";            ///< "sphere"
+  double radius = 0.02;                    ///< a [m]
+  Vec3 center = Vec3::Zero();              ///< [m]
+  std::string motion = "fixed";            ///< "free" | "fixed" | "prescribed"
+  Vec3 velocity = Vec3::Zero();            ///< [m/s], "prescribed" only
+  Vec3 angular_velocity = Vec3::Zero();    ///< [rad/s] about the centre, "prescribed" only
+  int surface_points = 400;                ///< regularized Stokeslets on the surface
+};
+
+/// A plane no-slip wall.
+struct WallConfig {
+  Vec3 point = Vec3::Zero();               ///< a point of the wall [m]
+  Vec3 normal = Vec3::UnitZ();             ///< into the fluid (normalized when read)
 };
 
 struct Config {
@@ -118,6 +138,8 @@ struct Config {
   SolverConfig solver;
   FlowFieldConfig flow_field;
   std::vector<RodConfig> rods;
+  std::vector<BodyConfig> bodies;
+  std::optional<WallConfig> wall;
 };
 
 /// Reads and validates a configuration file; `overrides` are "dotted.key=value" strings applied

@@ -69,15 +69,27 @@ const std::map<std::string, std::string>& Meanings() {
       {"rods.loads", "constant point forces, e.g. [{node = 64, force = [0, 0, -1e-3]}]"},
       {"rods.loads[].node", "node of the load, from 0"},
       {"rods.loads[].force", "force [N]"},
+      {"rods.body", "the body (from 1) whose frame holds the clamped nodes and against which the motor turns; 0: none (a \"fixed\" body only, for now)"},
+      {"bodies.shape", "\"sphere\""},
+      {"bodies.radius", "a [m]"},
+      {"bodies.center", "centre at the start [m]"},
+      {"bodies.motion", "\"fixed\", \"prescribed\" (velocity and angular_velocity) or \"free\" (not implemented yet: refused)"},
+      {"bodies.velocity", "U [m/s] of the centre, motion = \"prescribed\" only"},
+      {"bodies.angular_velocity", "Ω [rad/s] about the centre, motion = \"prescribed\" only"},
+      {"bodies.surface_points", "regularized Stokeslets on the surface (Fibonacci points, ε = 0.3 × their spacing; drag ~1.4 % low at 400, first order)"},
+      {"wall.point", "a point of the plane no-slip wall [m]"},
+      {"wall.normal", "its normal, pointing into the fluid (normalized); RSS only, dense mobility only"},
   };
   return m;
 }
 
 std::string Section(const std::string& key) {
   const std::string head = key.substr(0, key.find('.'));
-  return head == "rods" ? "[[rods]] (one table per rod; `--set rods.KEY=...` on every rod, "
-                          "`rods.K.KEY` on rod K)"
-                        : "[" + head + "]";
+  if (head == "rods")
+    return "[[rods]] (one table per rod; `--set rods.KEY=...` on every rod, `rods.K.KEY` on rod K)";
+  if (head == "bodies")
+    return "[[bodies]] (optional, one table per cell body; `--set bodies.K.KEY=...`)";
+  return head == "wall" ? "[wall] (optional: a plane no-slip wall)" : "[" + head + "]";
 }
 
 }  // namespace

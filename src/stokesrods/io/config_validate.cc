@@ -87,6 +87,8 @@ void ValidateRod(const Checker& c, const std::string& p, RodConfig* rod) {
 
 }  // namespace
 
+void ValidateBodiesAndWall(Config* config);  // config_bodies.cc
+
 void ValidateConfig(Config* config) {
   const Checker c{config->file};
   RunConfig& run = config->run;
@@ -156,9 +158,13 @@ void ValidateConfig(Config* config) {
   if (!flow.times.empty() && config->fluid.model == "none")
     throw ConfigError(c.file, "flow_field.times", "a flow field needs a fluid model");
 
-  if (config->rods.empty()) throw ConfigError(c.file, "rods", "at least one [[rods]] is required");
+  if (config->rods.empty() && config->bodies.empty())
+    throw ConfigError(c.file, "rods", "at least one [[rods]] (or [[bodies]]) is required");
+  if (config->rods.empty() && run.t_bar_end)
+    throw ConfigError(c.file, "run.t_bar_end", "needs a rod (its time scale μ l0⁴/EI); give run.duration");
   for (std::size_t i = 0; i < config->rods.size(); ++i)
     ValidateRod(c, fmt::format("rods.{}", i + 1), &config->rods[i]);
+  ValidateBodiesAndWall(config);
 }
 
 }  // namespace stokesrods

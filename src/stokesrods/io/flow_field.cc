@@ -7,6 +7,7 @@
 
 #include "stokesrods/io/writers.h"
 #include "stokesrods/fluid/mobility_operator.h"
+#include "stokesrods/sim/bodies.h"
 #include "stokesrods/sim/hydro_coupling.h"
 #include "stokesrods/solver/gmres.h"
 
@@ -22,13 +23,17 @@ std::string WriteFlowField(const Model& model, const State& state, const FlowFie
   const std::vector<HydroRod> rods = MakeHydroRods(model, positions);
   VecX u;
   GatherNodeVelocities(model, state.velocity, VecX::Zero(state.velocity.size()), 1.0, &u);
+  // The bodies' points follow the rods' nodes, with their rigid velocities.
+  const std::vector<BodySurface> bodies = BodySurfacesAt(model, state.time);
+  u.conservativeResize(3 * model.num_hydro_points());
+  u.tail(3 * model.num_body_points) = BodyPointVelocities(model, state.time);
   // The nodal forces on the fluid at the current positions and velocities, 𝕄 F = U: a dense LU
   // while 𝕄 is dense; with the matrix-free operator GMRES, preconditioned by the rods' own
   // self-mobilities (a dense 𝕄 of a hundred flagella would take 3 GB).
   VecX forces;
   const std::unique_ptr<MobilityOperator> mobility =
       MakeMobilityOperator(model.fluid, model.hydro.mobility);
-  mobility->Update(rods);
+  mobility->UpdateWithBodies(rods, bodies);
   if (const MatX* m = mobility->matrix()) {
     forces = m->partialPivLu().solve(u);
   } else {
@@ -51,7 +56,13 @@ std::string WriteFlowField(const Model& model, const State& state, const FlowFie
   for (int j = 0; j < nv; ++j)
     for (int i = 0; i < nu; ++i) {
       const Vec3 x = plane.origin + plane.u * i / (nu - 1.0) + plane.v * j / (nv - 1.0);
-      const Vec3 w = FluidVelocityAt(model.fluid, rods, forces, x);
+      // Below a wall there is no fluid.
+      const bool below = model.fluid.wall &&
+                         (x - model.fluid.wall->point).dot(model.fluid.wall->normal) < 0.0;
+      const Vec3 w = below ? Vec3(Vec3::Zero())
+                           : Vec3(FluidVelocityAt(model.fluid, rods, forces.head(3 * model.num_nodes), x) +
+                                  BodyBlobVelocityAt(model.fluid, bodies,
+                                                     forces.tail(3 * model.num_body_points), x));
       points += fmt::format("{:.8g} {:.8g} {:.8g}\n", x.x(), x.y(), x.z());
       velocity += fmt::format("{:.8g} {:.8g} {:.8g}\n", w.x(), w.y(), w.z());
       csv += fmt::format("{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g}\n", x.x(), x.y(), x.z(), w.x(),

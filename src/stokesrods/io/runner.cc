@@ -45,7 +45,8 @@ class Observer {
 
   void WriteFrame(const State& state, const Workspace& ws) {
     if (frames_) {
-      VecX hydro = ws.nonlocal_fluid ? ws.hydro_force : VecX();
+      // The rods' nodes' drag (the bodies' points follow them in ws.hydro_force).
+      VecX hydro = ws.nonlocal_fluid ? VecX(ws.hydro_force.head(3 * model_.num_nodes)) : VecX();
       VecX contact = VecX::Zero(3 * model_.num_nodes);
       for (const RodModel& rod : model_.rods)
         for (int i = 0; i < rod.num_nodes(); ++i)

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "stokesrods/common/assert.h"
+#include "stokesrods/sim/bodies.h"
 #include "stokesrods/sim/state.h"
 #include "stokesrods/solver/blas.h"
 #include "stokesrods/solver/gmres.h"
@@ -64,8 +65,12 @@ void HydroCoupling::Init(const Model& model) {
   explicit_ = model.coupling == FluidCoupling::kExplicit;
   // The whole capacitance's LU while it is small; above 3M = 3000 its O((3M)³) rebuilds cost more
   // than the extra GMRES products of the two-level preconditioner (docs/performance.md).
-  block_preconditioner_ =
-      mobility_->matrix() == nullptr || (krylov_ && 3 * model.num_nodes > kFullLuBelow);
+  // Bodies (dense only) keep the whole capacitance's LU: the blocks are per rod.
+  block_preconditioner_ = model.bodies.empty() &&
+      (mobility_->matrix() == nullptr || (krylov_ && 3 * model.num_nodes > kFullLuBelow));
+  SR_ASSERT(model.bodies.empty() || (!explicit_ && mobility_->matrix() != nullptr) ||
+                model.fluid.model != FluidModel::kRss,
+            "bodies need the implicit coupling and the dense mobility");
   SR_ASSERT(krylov_ || !block_preconditioner_, "the direct solve needs a dense mobility");
 }
 
@@ -75,7 +80,7 @@ HydroSolveReport HydroCoupling::Prepare(const Model& model, const VecX& q_start,
   positions_.resize(model.rods.size());
   for (int r = 0; r < static_cast<int>(model.rods.size()); ++r)
     positions_[static_cast<size_t>(r)] = RodPositions(model, r, q_start);
-  mobility_->Update(MakeHydroRods(model, positions_));
+  mobility_->UpdateWithBodies(MakeHydroRods(model, positions_), bodies_);
   mobility_changed_ = true;
   ++preconditioner_age_;
   HydroSolveReport report;
@@ -109,6 +114,11 @@ HydroSolveReport HydroCoupling::Prepare(const Model& model, const VecX& q_start,
   return report;
 }
 
+void HydroCoupling::SetBodies(const Model& model, double time) {
+  bodies_ = BodySurfacesAt(model, time);
+  body_velocity_ = BodyPointVelocities(model, time);
+}
+
 void HydroCoupling::ForgetReuse(const VecX& drag_guess) {
   have_preconditioner_ = false;
   preconditioner_h_ = -1.0;
@@ -131,7 +141,8 @@ void HydroCoupling::VelocityResidual(const Model& model, const VecX& q, const Ve
                                      double h, const VecX& f, VecX* r_u) const {
   mobility_->Apply(f, r_u);
   GatherNodeVelocities(model, q, q_start, h, &scratch_);  // fixed nodes: zero
-  *r_u += scratch_;
+  r_u->head(scratch_.size()) += scratch_;
+  r_u->tail(body_velocity_.size()) += body_velocity_;  // the bodies' known motion
 }
 
 bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
@@ -320,7 +331,7 @@ HydroSolveReport HydroCoupling::SolveNewtonSystem(const Model& model,
   HydroSolveReport report;
   // y = −B⁻¹ r_q, and S y.
   *dq = -r_q;
-  VecX sy(3 * model.num_nodes);
+  VecX sy = VecX::Zero(mobility_->size());  // zero on the bodies' points (no S there)
   const int num_rods = static_cast<int>(model.rods.size());
 #pragma omp parallel for schedule(static) if (num_rods > 1)
   for (int ri = 0; ri < num_rods; ++ri) {  // each rod's own DOFs and nodes

@@ -48,6 +48,12 @@ class HydroCoupling {
   /// The mobility operator and solver for the model (model.hydro_solver).
   void Init(const Model& model);
 
+  /// The cell bodies' surfaces and point velocities at `time` (sim/bodies.h) for the next
+  /// Prepare: their P points follow the M rod nodes in f and r_u (3(M + P)), with
+  ///   r_u,body = 𝕄 f|_body + u_body = 0,   u_body = U + Ω × (x − c) known (fixed, prescribed);
+  /// S has no rows there, so C = h𝕄 + S X extends by the bodies' rows and columns of h𝕄.
+  void SetBodies(const Model& model, double time);
+
   /// Takes 𝕄 at q_start; for the explicit coupling also solves for the drag of v_start.
   HydroSolveReport Prepare(const Model& model, const VecX& q_start, const VecX& v_start);
 
@@ -57,7 +63,7 @@ class HydroCoupling {
   /// force += Sᵀ f: the nodal forces f (3M) on the rods' position DOFs.
   static void AddNodalForce(const Model& model, const VecX& f, VecX* force);
 
-  /// r_u = S(q − q_start)/h + 𝕄 f (3M) [m/s].
+  /// r_u = S(q − q_start)/h + 𝕄 f (3M), plus the bodies' rows (3P) [m/s].
   void VelocityResidual(const Model& model, const VecX& q, const VecX& q_start, double h,
                         const VecX& f, VecX* r_u) const;
 
@@ -101,6 +107,8 @@ class HydroCoupling {
 
   std::unique_ptr<MobilityOperator> mobility_;
   std::vector<Matrix3X> positions_;  ///< at the last Prepare (the operator points into them)
+  std::vector<BodySurface> bodies_;  ///< of the last SetBodies
+  VecX body_velocity_;               ///< 3P, of the last SetBodies
   bool krylov_ = false;
   bool explicit_ = false;
   bool mobility_changed_ = true;   ///< 𝕄 was updated since the capacitance was factorized

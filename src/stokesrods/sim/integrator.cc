@@ -18,7 +18,7 @@ Workspace::Workspace(const Model& model) : local_forces(MakeLocalForces(model)) 
   for (const RodModel& rod : model.rods) jacobian.emplace_back(rod.num_dofs(), 10);
   if (nonlocal_fluid) {
     hydro.Init(model);
-    hydro_force = hydro_force_try = VecX::Zero(3 * model.num_nodes);
+    hydro_force = hydro_force_try = VecX::Zero(3 * model.num_hydro_points());
   }
 }
 
@@ -71,6 +71,11 @@ double VelocityResidualNorm(const Model& model, const VecX& r_u) {
     for (int i = 0; i < rod.num_nodes(); ++i)
       norm = std::max(norm, drag * rod.rest_voronoi_length(i) *
                                 r_u.segment<3>(3 * (rod.node_offset + i)).cwiseAbs().maxCoeff());
+  for (const BodyModel& body : model.bodies)  // a surface point: the drag of its blob, 4πμ ε
+    for (int j = 0; j < body.num_points(); ++j)
+      norm = std::max(norm, drag * body.regularization *
+                                r_u.segment<3>(3 * (model.num_nodes + body.point_offset + j))
+                                    .cwiseAbs().maxCoeff());
   return norm;
 }
 
@@ -297,6 +302,7 @@ NewtonReport SolveNewton(const Model& model, const State& start, double h, Works
 void PrepareStep(const Model& model, const State& start, Workspace* ws) {
   for (const auto& f : ws->local_forces) f->Prepare(model, start.q);
   if (ws->nonlocal_fluid) {
+    if (!model.bodies.empty()) ws->hydro.SetBodies(model, start.time);
     ws->hydro.Prepare(model, start.q, start.velocity);
     if (model.coupling == FluidCoupling::kExplicit) ws->hydro_force = ws->hydro.explicit_force();
   }
@@ -343,6 +349,7 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
     State& geometry = ws->step_geometry;  // where the step's mobility and local drag are taken
     geometry.q = ws->q;
     geometry.velocity = state->velocity;
+    geometry.time = state->time + h;  // the predictor's time (the bodies' pose)
     PrepareStep(model, geometry, ws);
   } else {
     PrepareStep(model, start, ws);
@@ -374,7 +381,7 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
       ws->factors_h = he;
       ws->factors_age = 0;
     }
-    const VecX no_slip = VecX::Zero(ws->nonlocal_fluid ? 3 * model.num_nodes : 0);
+    const VecX no_slip = VecX::Zero(ws->nonlocal_fluid ? 3 * model.num_hydro_points() : 0);
     const LinearResponse respond = [&](const VecX& force, VecX* dq) {
       VecX df, du;  // −J⁻¹(−F) = J⁻¹ F, the drag responding with the rods
       report.krylov_iterations += NewtonCorrection(model, he, -force, no_slip, ws, dq, &df, &du);

@@ -68,6 +68,18 @@ void FinalizeLayout(Model* model) {
   model->num_dofs = dofs;
   model->num_nodes = nodes;
   model->force_scale = force_scale;
+  int points = 0;
+  for (BodyModel& body : model->bodies) {
+    body.point_offset = points;
+    points += body.num_points();
+    // Without rods the bodies set the scales: their size and their Stokes drag.
+    if (!model->rods.empty()) continue;
+    model->length_scale = std::max(model->length_scale, 2.0 * body.radius);
+    model->max_voronoi_length = std::max(model->max_voronoi_length, body.regularization);
+    model->force_scale = std::max(model->force_scale, 6.0 * kPi * model->fluid.viscosity * body.radius *
+                                                          (body.velocity.norm() + body.radius * body.angular_velocity.norm()));
+  }
+  model->num_body_points = points;
 }
 
 }  // namespace stokesrods

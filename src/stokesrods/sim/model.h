@@ -60,6 +60,24 @@ struct RodModel {
   int num_dofs() const { return RodDofCount(num_nodes()); }
 };
 
+/// A rigid cell body (issue 11): its surface as regularized Stokeslets (fluid/rigid_body.h),
+/// more sources and targets of the mobility beside the rods' nodes. Its motion is known:
+/// "fixed", or "prescribed" with constant U and Ω (the pose at time t follows in closed form).
+enum class BodyMotion { kFixed, kPrescribed };
+
+struct BodyModel {
+  double radius = 0.0;                     ///< a [m]
+  Vec3 center = Vec3::Zero();              ///< at t = 0 [m]
+  BodyMotion motion = BodyMotion::kFixed;
+  Vec3 velocity = Vec3::Zero();            ///< U [m/s]
+  Vec3 angular_velocity = Vec3::Zero();    ///< Ω about the centre [rad/s]
+  Matrix3X surface;                        ///< surface points relative to the centre at t = 0 [m]
+  double regularization = 0.0;             ///< ε of the surface blobs [m]
+  int point_offset = 0;                    ///< first of its points after all rods' nodes
+
+  int num_points() const { return static_cast<int>(surface.cols()); }
+};
+
 enum class FluidCoupling { kImplicit, kExplicit };
 /// kEuler: implicit Euler (paper eq. 22), first order. kBdf2: the two-step backward
 /// differentiation formula, second order (its first step is implicit Euler).
@@ -85,6 +103,7 @@ struct HydroOptions {
 
 struct Model {
   std::vector<RodModel> rods;
+  std::vector<BodyModel> bodies;     ///< their points follow the rods' nodes in the drag vector
   FluidParams fluid;                 ///< fluid.model == kNone: no hydrodynamics
   FluidCoupling coupling = FluidCoupling::kImplicit;
   TimeIntegrator integrator = TimeIntegrator::kEuler;
@@ -99,9 +118,13 @@ struct Model {
 
   int num_dofs = 0;
   int num_nodes = 0;
+  int num_body_points = 0;           ///< P: the drag vector has 3(M + P) entries
+
+  int num_hydro_points() const { return num_nodes + num_body_points; }
 };
 
-/// Fills dof_offset/node_offset, num_dofs/num_nodes, force_scale and length_scale from the rods.
+/// Fills dof_offset/node_offset, num_dofs/num_nodes, force_scale and length_scale from the rods,
+/// the bodies' point_offset and num_body_points.
 void FinalizeLayout(Model* model);
 
 /// Fills the rest quantities (lengths, Voronoi lengths, masses, rest curvatures and twist from

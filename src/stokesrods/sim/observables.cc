@@ -4,11 +4,13 @@
 
 #include <fmt/format.h>
 
+#include "stokesrods/sim/bodies.h"
 #include "stokesrods/sim/contact_forces.h"
 
 namespace stokesrods {
 
 Scales CalcScales(const Model& model) {
+  if (model.rods.empty()) return {1.0, 1.0};  // bodies only: SI units
   const RodModel& rod = model.rods.front();
   const double l0 = rod.axis_length;
   return {model.fluid.viscosity * std::pow(l0, 4) / rod.bending_stiffness,
@@ -26,6 +28,10 @@ std::vector<std::string> TimeseriesColumns(const Model& model) {
   if (rods >= 2) names.insert(names.end(), {"delta_b", "delta_b_over_R", "min_distance", "contacts"});
   for (int k = 1; k <= rods; ++k) names.push_back(fmt::format("rod{}_tip_axis_distance", k));
   names.insert(names.end(), {"max_penetration", "newton_iterations"});
+  for (int k = 1; k <= static_cast<int>(model.bodies.size()); ++k)  // SPEC "Additions"
+    for (const char* c : {"x", "y", "z", "force_x", "force_y", "force_z", "omega_x", "omega_y",
+                          "omega_z"})
+      names.push_back(fmt::format("body{}_{}", k, c));
   return names;
 }
 
@@ -61,6 +67,16 @@ std::vector<double> CalcTimeseriesRow(const Model& model, const State& state, co
   }
   row.insert(row.end(), {report.contact.max_penetration,
                          static_cast<double>(report.newton_iterations)});
+  for (int k = 0; k < static_cast<int>(model.bodies.size()); ++k) {
+    const BodyModel& body = model.bodies[static_cast<size_t>(k)];
+    const Vec3 c = BodyCenterAt(body, state.time);
+    // The fluid's force of the last step (the drag vector holds the bodies' points after the rods').
+    const Vec3 f = ws.hydro_force.size() == 3 * model.num_hydro_points()
+                       ? Vec3(BodyHydroLoad(model, k, state.time, ws.hydro_force).head<3>())
+                       : Vec3::Zero();
+    const Vec3& w = body.angular_velocity;
+    row.insert(row.end(), {c.x(), c.y(), c.z(), f.x(), f.y(), f.z(), w.x(), w.y(), w.z()});
+  }
   return row;
 }
 

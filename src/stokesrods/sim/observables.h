@@ -10,7 +10,7 @@
 
 namespace stokesrods {
 
-/// Normalization of the paper (eq. 24, 26) from rod 1: EI, μ and l0.
+/// Normalization of the paper (eq. 24, 26) from rod 1: EI, μ and l0 (1 s and 1 N without rods).
 struct Scales {
   double time = 1.0;   ///< μ l0⁴ / EI [s]
   double force = 1.0;  ///< EI / l0² [N]

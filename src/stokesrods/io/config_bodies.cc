@@ -1,0 +1,97 @@
+// Checks of [[bodies]], [wall] and the rods' `body` key (SPEC "Additions") whose types are already
+// right; the geometric checks that need the rods' shapes (overlaps, the wall crossing) are in
+// build_bodies.cc.
+#include <cmath>
+#include <set>
+
+#include <fmt/format.h>
+
+#include "stokesrods/io/config.h"
+
+namespace stokesrods {
+namespace {
+
+void CheckFinite(const std::string& file, const std::string& key, const Vec3& v) {
+  if (!v.allFinite()) throw ConfigError(file, key, "must be finite");
+}
+
+void ValidateBody(const Config& config, const std::string& p, const BodyConfig& body) {
+  const std::string& file = config.file;
+  if (body.shape != "sphere")
+    throw ConfigError(file, p + ".shape", fmt::format("\"{}\" is not one of \"sphere\"", body.shape));
+  if (!(body.radius > 0.0) || !std::isfinite(body.radius))
+    throw ConfigError(file, p + ".radius", fmt::format("must be a finite number > 0 (got {})", body.radius));
+  CheckFinite(file, p + ".center", body.center);
+  CheckFinite(file, p + ".velocity", body.velocity);
+  CheckFinite(file, p + ".angular_velocity", body.angular_velocity);
+  static const std::set<std::string> kMotions = {"fixed", "free", "prescribed"};
+  if (kMotions.count(body.motion) == 0)
+    throw ConfigError(file, p + ".motion",
+                      fmt::format("\"{}\" is not one of \"fixed\", \"free\", \"prescribed\"", body.motion));
+  if (body.motion == "free")
+    throw ConfigError(file, p + ".motion",
+                      "\"free\" bodies are not implemented in the coupled solve yet (issue 11); "
+                      "use \"fixed\" or \"prescribed\"");
+  if (body.motion != "prescribed" && (body.velocity != Vec3::Zero() || body.angular_velocity != Vec3::Zero()))
+    throw ConfigError(file, p + (body.velocity != Vec3::Zero() ? ".velocity" : ".angular_velocity"),
+                      "only for motion = \"prescribed\"");
+  if (body.surface_points < 20 || body.surface_points > 20000)
+    throw ConfigError(file, p + ".surface_points",
+                      fmt::format("must be between 20 and 20000 (got {})", body.surface_points));
+  if (config.fluid.model != "rss")
+    throw ConfigError(file, p, fmt::format("bodies need fluid.model = \"rss\" (got \"{}\")",
+                                           config.fluid.model));
+  if (config.fluid.mobility == "matrix_free")
+    throw ConfigError(file, "fluid.mobility",
+                      "\"matrix_free\" does not take bodies yet; use \"dense\" or \"auto\"");
+  if (config.fluid.coupling == "explicit")
+    throw ConfigError(file, "fluid.coupling", "bodies need fluid.coupling = \"implicit\"");
+}
+
+void ValidateWall(Config* config) {
+  const std::string& file = config->file;
+  WallConfig& wall = *config->wall;
+  CheckFinite(file, "wall.point", wall.point);
+  CheckFinite(file, "wall.normal", wall.normal);
+  if (!(wall.normal.norm() > 0.0))
+    throw ConfigError(file, "wall.normal", "must not be the zero vector");
+  wall.normal.normalize();
+  const std::string& model = config->fluid.model;
+  if (model != "rss")
+    throw ConfigError(file, "wall",
+                      fmt::format("fluid.model = \"{}\" has no wall: a wall acts through the "
+                                  "regularized images of fluid.model = \"rss\" (no wall "
+                                  "correction of LSBT or RFT, no wall contact yet)",
+                                  model));
+  if (config->fluid.mobility == "matrix_free")
+    throw ConfigError(file, "fluid.mobility",
+                      "\"matrix_free\" has no wall images yet; with a [wall] use \"dense\" or "
+                      "\"auto\" (which then stays dense)");
+}
+
+}  // namespace
+
+void ValidateBodiesAndWall(Config* config) {
+  for (std::size_t k = 0; k < config->bodies.size(); ++k)
+    ValidateBody(*config, fmt::format("bodies.{}", k + 1), config->bodies[k]);
+  if (config->wall) ValidateWall(config);
+  for (std::size_t r = 0; r < config->rods.size(); ++r) {
+    const RodConfig& rod = config->rods[r];
+    const std::string key = fmt::format("rods.{}.body", r + 1);
+    if (rod.body == 0) continue;
+    if (rod.body < 0 || rod.body > static_cast<int>(config->bodies.size()))
+      throw ConfigError(config->file, key,
+                        fmt::format("body {} does not exist (there are {} [[bodies]])", rod.body,
+                                    config->bodies.size()));
+    const BodyConfig& body = config->bodies[static_cast<std::size_t>(rod.body - 1)];
+    if (body.motion != "fixed")
+      throw ConfigError(config->file, key,
+                        fmt::format("rods on a \"{}\" body are not implemented yet (their clamp "
+                                    "would move with it); attach rods to a \"fixed\" body",
+                                    body.motion));
+    if (rod.clamped_nodes < 1)
+      throw ConfigError(config->file, key, "a rod on a body needs clamped_nodes ≥ 1");
+  }
+}
+
+}  // namespace stokesrods

