@@ -3,12 +3,18 @@
 // dragged along by a passing sphere, and a rotating helix held beside a wall.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include "stokesrods/fluid/rigid_body.h"
 #include "stokesrods/io/build_bodies.h"
+#include "stokesrods/io/runner.h"
 #include "stokesrods/io/simulation.h"
 #include "stokesrods/sim/bodies.h"
 #include "stokesrods/sim/observables.h"
@@ -98,6 +104,49 @@ TEST(BodiesValidation, ASphereMovingPastARodDragsItAlong) {
   std::printf("rod tip x = %.4e m; sphere drag %.6e N (alone %.6e N)\n", tip_x, drag, alone);
   EXPECT_GT(tip_x, 0.0);
   EXPECT_LT(drag, alone);  // more negative: the rod is in the way
+}
+
+constexpr char kPass[] =
+    "[run]\nduration = 0.1\ntime_step = 0.01\noutput_interval = 0.05\ncheckpoint_interval = 0.05\n"
+    "[[rods]]\nshape = \"straight\"\nnodes = 21\naxis_length = 0.1\nradius = 1e-3\n"
+    "young_modulus = 1e5\n"
+    "[[bodies]]\nradius = 0.02\ncenter = [0.0, 0.03, -0.07]\nmotion = \"prescribed\"\n"
+    "velocity = [0.01, 0.0, 0.0]\nangular_velocity = [0.0, 0.0, 2.0]\nsurface_points = 100\n";
+
+// A checkpoint holds the drag of the bodies' points too: continuing from it is bit-identical.
+TEST(BodiesValidation, ACheckpointResumesBitIdentically) {
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("stokesrods_bodies_checkpoint." + std::to_string(getpid()))).string();
+  Simulation a(ParseConfig(kPass, "pass.toml"));
+  for (int k = 0; k < 4; ++k) ASSERT_TRUE(a.Step().ok);
+  a.SaveCheckpoint(path);
+  Simulation b(ParseConfig(kPass, "pass.toml"));
+  b.LoadCheckpoint(path);
+  std::filesystem::remove(path);
+  for (int k = 0; k < 4; ++k) {
+    ASSERT_TRUE(a.Step().ok);
+    ASSERT_TRUE(b.Step().ok);
+  }
+  EXPECT_EQ(a.state().q, b.state().q);
+  EXPECT_EQ(a.workspace().hydro_force, b.workspace().hydro_force);
+  EXPECT_EQ(Column(a, "body1_force_x"), Column(b, "body1_force_x"));
+}
+
+// The run writes the bodies' frames beside the rods' (bodies.pvd, frames/bodies_NNNNN.vtp).
+TEST(BodiesValidation, TheRunWritesBodyFrames) {
+  const std::string dir = (std::filesystem::temp_directory_path() /
+                           ("stokesrods_bodies_frames." + std::to_string(getpid()))).string();
+  Config config = ParseConfig(kPass, "pass.toml");
+  config.run.output = dir;
+  const RunResult result = RunCase(config);
+  ASSERT_EQ(result.status, RunStatus::kCompleted) << result.message;
+  std::stringstream pvd, vtp;
+  pvd << std::ifstream(dir + "/bodies.pvd").rdbuf();
+  vtp << std::ifstream(dir + "/frames/bodies_00002.vtp").rdbuf();
+  std::filesystem::remove_all(dir);
+  EXPECT_NE(pvd.str().find("frames/bodies_00002.vtp"), std::string::npos);
+  EXPECT_NE(vtp.str().find("NumberOfPoints=\"100\""), std::string::npos);
+  EXPECT_NE(vtp.str().find("Name=\"hydrodynamic_force\""), std::string::npos);
 }
 
 }  // namespace

@@ -78,6 +78,17 @@ std::vector<std::string> LeadingLines(const std::string& path, const std::string
   return lines;
 }
 
+// Appends a frame to a .pvd index and rewrites it.
+void AddToIndex(const std::string& dir, const char* index, double time, const std::string& file,
+                std::vector<std::string>* entries) {
+  entries->push_back(
+      fmt::format("<DataSet timestep=\"{:.10g}\" part=\"0\" file=\"{}\"/>", time, file));
+  std::string pvd = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
+  for (const std::string& entry : *entries) pvd += entry + "\n";
+  pvd += "</Collection>\n</VTKFile>\n";
+  WriteFileAtomically((fs::path(dir) / index).string(), pvd);
+}
+
 }  // namespace
 
 void TruncateCsv(const std::string& path, long rows) {
@@ -97,6 +108,7 @@ void TruncateCsv(const std::string& path, long rows) {
 FrameWriter::FrameWriter(const std::string& output_dir, long keep, bool binary)
     : dir_(output_dir),
       binary_(binary),
+      keep_(keep),
       entries_(LeadingLines((fs::path(output_dir) / "rods.pvd").string(), "<DataSet ", keep)) {
   std::error_code ec;
   fs::create_directories(fs::path(dir_) / "frames", ec);
@@ -104,7 +116,7 @@ FrameWriter::FrameWriter(const std::string& output_dir, long keep, bool binary)
 }
 
 void FrameWriter::Write(const Model& model, const State& state,
-                        const std::vector<FramePointData>& data) {
+                        const std::vector<FramePointData>& data, const VecX* body_forces) {
   const std::string name = fmt::format("frames/rods_{:05d}.vtp", entries_.size());
   const std::size_t m = static_cast<std::size_t>(model.num_nodes);
   std::vector<double> points, radius, d1, d2;
@@ -144,13 +156,15 @@ void FrameWriter::Write(const Model& model, const State& state,
   }
   xml += "</PointData>\n</Piece>\n</PolyData>\n</VTKFile>\n";
   WriteFileAtomically((fs::path(dir_) / name).string(), xml);
-  entries_.push_back(
-      fmt::format("<DataSet timestep=\"{:.10g}\" part=\"0\" file=\"{}\"/>", state.time, name));
-
-  std::string pvd = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
-  for (const std::string& entry : entries_) pvd += entry + "\n";
-  pvd += "</Collection>\n</VTKFile>\n";
-  WriteFileAtomically((fs::path(dir_) / "rods.pvd").string(), pvd);
+  AddToIndex(dir_, "rods.pvd", state.time, name, &entries_);
+  if (model.bodies.empty()) return;
+  if (!body_entries_read_)
+    body_entries_ = LeadingLines((fs::path(dir_) / "bodies.pvd").string(), "<DataSet ", keep_);
+  body_entries_read_ = true;
+  const std::string body_name = fmt::format("frames/bodies_{:05d}.vtp", body_entries_.size());
+  WriteFileAtomically((fs::path(dir_) / body_name).string(),
+                      BodyFrameXml(model, state, body_forces, binary_));
+  AddToIndex(dir_, "bodies.pvd", state.time, body_name, &body_entries_);
 }
 
 }  // namespace stokesrods

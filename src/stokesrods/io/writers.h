@@ -46,13 +46,23 @@ class FrameWriter {
   /// which must have them; the next frame is number `keep`.
   /// `binary`: base64 arrays (exact doubles, faster to read; about the size of the ASCII).
   explicit FrameWriter(const std::string& output_dir, long keep = 0, bool binary = false);
-  void Write(const Model& model, const State& state, const std::vector<FramePointData>& data);
+  /// With bodies, also frames/bodies_NNNNN.vtp (their surface points as vertices, with `body`,
+  /// `velocity` and, given `body_forces` (3P), `hydrodynamic_force`) and the bodies.pvd index.
+  void Write(const Model& model, const State& state, const std::vector<FramePointData>& data,
+             const VecX* body_forces = nullptr);
 
  private:
   std::string dir_;
   bool binary_ = false;
+  long keep_ = 0;
   std::vector<std::string> entries_;  ///< the DataSet lines of rods.pvd
+  std::vector<std::string> body_entries_;  ///< of bodies.pvd (read on the first body frame)
+  bool body_entries_read_ = false;
 };
+
+/// The bodies' surface points at the state's time as a VTK PolyData file (vertices).
+std::string BodyFrameXml(const Model& model, const State& state, const VecX* body_forces,
+                         bool binary);
 
 /// Keeps the header and the first `rows` rows of an existing CSV file (--resume); IoError if it
 /// has fewer.

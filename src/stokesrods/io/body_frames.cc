@@ -1,0 +1,41 @@
+// The bodies' ParaView frames (writers.h): surface points as vertices.
+#include <fmt/format.h>
+
+#include "stokesrods/io/vtk_arrays.h"
+#include "stokesrods/io/writers.h"
+#include "stokesrods/sim/bodies.h"
+
+namespace stokesrods {
+
+std::string BodyFrameXml(const Model& model, const State& state, const VecX* body_forces,
+                         bool binary) {
+  const std::vector<BodySurface> surfaces = BodySurfacesAt(model, state.time);
+  const VecX velocity = BodyPointVelocities(model, state.time);
+  const std::size_t p = static_cast<std::size_t>(model.num_body_points);
+  std::vector<double> points, velocities(velocity.data(), velocity.data() + 3 * p);
+  std::vector<std::int32_t> connectivity, offsets, body_id;
+  for (std::size_t k = 0; k < surfaces.size(); ++k)
+    for (Eigen::Index j = 0; j < surfaces[k].points.cols(); ++j) {
+      const Vec3 x = surfaces[k].points.col(j);
+      points.insert(points.end(), {x.x(), x.y(), x.z()});
+      connectivity.push_back(static_cast<std::int32_t>(body_id.size()));
+      offsets.push_back(static_cast<std::int32_t>(body_id.size() + 1));
+      body_id.push_back(static_cast<std::int32_t>(k + 1));
+    }
+  std::string xml = fmt::format(
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" "
+      "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<PolyData>\n"
+      "<Piece NumberOfPoints=\"{0}\" NumberOfVerts=\"{0}\">\n<Points>\n", p);
+  xml += VtkDataArray("points", points, 3, binary, 10) + "</Points>\n<Verts>\n";
+  xml += VtkDataArray("connectivity", connectivity, 1, binary);
+  xml += VtkDataArray("offsets", offsets, 1, binary) + "</Verts>\n";
+  xml += "<PointData>\n" + VtkDataArray("body", body_id, 1, binary);
+  xml += VtkDataArray("velocity", velocities, 3, binary, 8);
+  if (body_forces != nullptr && static_cast<std::size_t>(body_forces->size()) == 3 * p)
+    xml += VtkDataArray("hydrodynamic_force",
+                        std::vector<double>(body_forces->data(), body_forces->data() + 3 * p), 3,
+                        binary, 8);
+  return xml + "</PointData>\n</Piece>\n</PolyData>\n</VTKFile>\n";
+}
+
+}  // namespace stokesrods
