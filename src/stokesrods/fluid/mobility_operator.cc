@@ -14,7 +14,7 @@
 namespace stokesrods {
 
 void MobilityOperator::SetLayout(const std::vector<HydroRod>& rods) {
-  num_body_points_ = 0;
+  num_body_points_ = num_free_bodies_ = 0;
   node_offset_.assign(1, 0);
   for (const HydroRod& rod : rods)
     node_offset_.push_back(node_offset_.back() + static_cast<int>(rod.x->cols()));
@@ -34,8 +34,11 @@ class DenseMobility final : public MobilityOperator {
                         const std::vector<BodySurface>& bodies) override {
     if (bodies.empty()) return Update(rods);  // every fluid model
     SetLayout(rods);
-    for (const BodySurface& b : bodies) num_body_points_ += static_cast<int>(b.points.cols());
-    matrix_ = AssembleMobilityWithBodies(params_, rods, bodies);
+    for (const BodySurface& b : bodies) {
+      num_body_points_ += static_cast<int>(b.points.cols());
+      num_free_bodies_ += b.free ? 1 : 0;
+    }
+    matrix_ = AssembleBorderedMobility(params_, rods, bodies);
   }
   void Apply(const VecX& force, VecX* velocity) const override {
     // Row blocks in parallel: the product streams the whole matrix (memory bound beyond cache).

@@ -55,7 +55,8 @@ class MobilityOperator {
   /// Takes the geometry: 𝕄 = 𝕄(x) for the rods as they are now.
   virtual void Update(const std::vector<HydroRod>& rods) = 0;
   /// The same with the bodies' surfaces (fluid/rigid_body.h), their P points after the rods' M
-  /// nodes in F and U: size() is 3(M + P). Operators without bodies take an empty list only.
+  /// nodes in F and U, then the free bodies' rigid motions (AssembleBorderedMobility): size() is
+  /// 3(M + P) + 6B. Operators without bodies take an empty list only.
   virtual void UpdateWithBodies(const std::vector<HydroRod>& rods,
                                 const std::vector<BodySurface>& bodies) {
     SR_ASSERT(bodies.empty(), "this mobility operator does not take bodies");
@@ -68,7 +69,7 @@ class MobilityOperator {
   /// The assembled 𝕄 when the operator holds one, else nullptr.
   virtual const MatX* matrix() const { return nullptr; }
 
-  int size() const { return 3 * (node_offset_.back() + num_body_points_); }
+  int size() const { return 3 * (node_offset_.back() + num_body_points_) + 6 * num_free_bodies_; }
   int num_rods() const { return static_cast<int>(node_offset_.size()) - 1; }
   /// First node of rod k among all nodes; node_offset(num_rods()) = M.
   int node_offset(int rod) const { return node_offset_[static_cast<size_t>(rod)]; }
@@ -77,6 +78,7 @@ class MobilityOperator {
   void SetLayout(const std::vector<HydroRod>& rods);
   std::vector<int> node_offset_ = {0};
   int num_body_points_ = 0;  ///< P (UpdateWithBodies)
+  int num_free_bodies_ = 0;  ///< B (UpdateWithBodies)
 };
 
 /// Block-Jacobi approximation of 𝕄⁻¹ by the LU of each rod's self-mobility 𝕄_kk: the

@@ -128,6 +128,34 @@ MatX AssembleMobilityWithBodies(const FluidParams& params, const std::vector<Hyd
   return m;
 }
 
+MatX AssembleBorderedMobility(const FluidParams& params, const std::vector<HydroRod>& rods,
+                              const std::vector<BodySurface>& bodies) {
+  const MatX m = AssembleMobilityWithBodies(params, rods, bodies);
+  int free = 0;
+  for (const BodySurface& b : bodies) free += b.free ? 1 : 0;
+  if (free == 0) return m;
+  MatX out = MatX::Zero(m.rows() + 6 * free, m.cols() + 6 * free);
+  out.topLeftCorner(m.rows(), m.cols()) = m;
+  Eigen::Index point = rods.empty() ? 0 : TotalNodes(rods), mode = m.rows();
+  for (const BodySurface& b : bodies) {
+    if (b.free) {
+      for (Eigen::Index j = 0; j < b.points.cols(); ++j) {
+        const Vec3 r = b.points.col(j) - b.center;
+        for (int c = 0; c < 3; ++c) {
+          const Vec3 rotation = Vec3::Unit(c).cross(r);
+          out.block<3, 1>(3 * (point + j), mode + c) = Vec3::Unit(c);
+          out.block<3, 1>(3 * (point + j), mode + 3 + c) = rotation;
+          out.block<1, 3>(mode + c, 3 * (point + j)) = Vec3::Unit(c).transpose();
+          out.block<1, 3>(mode + 3 + c, 3 * (point + j)) = rotation.transpose();
+        }
+      }
+      mode += 6;
+    }
+    point += b.points.cols();
+  }
+  return out;
+}
+
 Vec3 BodyBlobVelocityAt(const FluidParams& params, const std::vector<BodySurface>& bodies,
                         const VecX& forces, const Vec3& point) {
   const Wall* wall = params.wall ? &*params.wall : nullptr;

@@ -22,6 +22,10 @@ namespace stokesrods {
 struct BodySurface {
   Matrix3X points;             ///< on the surface (3 × N) [m]
   double regularization = 0;   ///< ε [m]
+  /// A free body (issue 11): its rigid motion (U, Ω) about `center` is an unknown with the
+  /// balance of the fluid's force and torque on it (AssembleMobilityWithBodies' border).
+  bool free = false;
+  Vec3 center = Vec3::Zero();  ///< [m]
 };
 
 /// N ≥ 2 nearly uniform points on the unit sphere (Fibonacci lattice), deterministic.
@@ -46,6 +50,14 @@ Mat6 RigidResistance(const BodySurface& surface, const Vec3& center, double visc
 /// with its images [m/(N·s)]. RSS only.
 MatX AssembleMobilityWithBodies(const FluidParams& params, const std::vector<HydroRod>& rods,
                                 const std::vector<BodySurface>& bodies);
+
+/// The mobility of rods and bodies bordered by the free bodies' rigid motions (6 per free body):
+///   [𝕄  G; Gᵀ 0],  G_j = [I, −[x_j − c]×] at a free body's points (u_j = U + Ω × (x_j − c)),
+/// so that with f the forces of the fluid on the rods and bodies and V = (U, Ω),
+///   [𝕄 f + G V; Gᵀ f] = [−(known velocities); 0]  is no slip and each free body's balance of
+/// force and torque (it has no other load). Without free bodies, AssembleMobilityWithBodies.
+MatX AssembleBorderedMobility(const FluidParams& params, const std::vector<HydroRod>& rods,
+                              const std::vector<BodySurface>& bodies);
 
 /// The velocity at `point` of the bodies' blobs carrying the forces F (3P, on the fluid, in the
 /// order of AssembleMobilityWithBodies), with params.wall's images if any [m/s].

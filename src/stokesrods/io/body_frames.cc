@@ -9,8 +9,8 @@ namespace stokesrods {
 
 std::string BodyFrameXml(const Model& model, const State& state, const VecX* body_forces,
                          bool binary) {
-  const std::vector<BodySurface> surfaces = BodySurfacesAt(model, state.time);
-  const VecX velocity = BodyPointVelocities(model, state.time);
+  const std::vector<BodySurface> surfaces = BodySurfaces(model, state.bodies);
+  const VecX velocity = BodyPointVelocities(model, state.bodies);  // free bodies: 0
   const std::size_t p = static_cast<std::size_t>(model.num_body_points);
   std::vector<double> points, velocities(velocity.data(), velocity.data() + 3 * p);
   std::vector<std::int32_t> connectivity, offsets, body_id;

@@ -90,7 +90,9 @@ void AddBodies(const Config& config, Model* model) {
     BodyModel body;
     body.radius = bc.radius;
     body.center = bc.center;
-    body.motion = bc.motion == "prescribed" ? BodyMotion::kPrescribed : BodyMotion::kFixed;
+    body.motion = bc.motion == "prescribed" ? BodyMotion::kPrescribed
+                  : bc.motion == "free"     ? BodyMotion::kFree
+                                            : BodyMotion::kFixed;
     body.velocity = bc.velocity;
     body.angular_velocity = bc.angular_velocity;
     const BodySurface surface =

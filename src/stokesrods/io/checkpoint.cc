@@ -84,6 +84,11 @@ std::uint64_t ModelFingerprint(const Model& model) {
     w.Put(rod.bending_stiffness);
     w.Put(rod.twisting_stiffness);
   }
+  for (const BodyModel& body : model.bodies) {  // nothing without bodies (older files still read)
+    w.Put(body.radius);
+    w.Put(static_cast<std::int64_t>(body.num_points()));
+    w.Put(static_cast<std::int64_t>(body.motion));
+  }
   return Fnv1a(w.text().data(), w.text().size());
 }
 
@@ -112,6 +117,10 @@ void SaveCheckpoint(const std::string& path, const Model& model, const Checkpoin
   w.Put(static_cast<std::int64_t>(c.counters.newton_iterations));
   w.Put(c.counters.max_penetration);
   w.Put(static_cast<std::int64_t>(c.counters.step_reductions));
+  for (const BodyPose& pose : c.state.bodies) {  // nothing without bodies (older files still read)
+    w.Raw(pose.center.data(), 3 * sizeof(double));
+    w.Raw(pose.rotation.data(), 9 * sizeof(double));
+  }
   w.Put(Fnv1a(w.text().data(), w.text().size()));
   WriteFileAtomically(path, w.text());
 }
@@ -160,10 +169,16 @@ Checkpoint LoadCheckpoint(const std::string& path, const Model& model) {
   c.history.previous_q = r.Vector(model.num_dofs, "the previous q", true);
   c.history.previous_velocity = r.Vector(model.num_dofs, "the previous velocity", true);
   c.history.previous_h = r.Get<double>();
-  c.history.hydro_force = r.Vector(3 * model.num_hydro_points(), "the drag", true);
+  c.history.hydro_force = r.Vector(model.hydro_size(), "the drag", true);
   c.counters.newton_iterations = static_cast<long>(r.Get<std::int64_t>());
   c.counters.max_penetration = r.Get<double>();
   c.counters.step_reductions = static_cast<long>(r.Get<std::int64_t>());
+  c.state.bodies.resize(model.bodies.size());
+  for (BodyPose& pose : c.state.bodies) {
+    if (r.at() + 12 * sizeof(double) + sizeof stored_sum > text.size()) r.Fail("truncated");
+    r.Raw(pose.center.data(), 3 * sizeof(double));
+    r.Raw(pose.rotation.data(), 9 * sizeof(double));
+  }
   if (r.at() + sizeof stored_sum != text.size()) r.Fail("unexpected data after the contents");
   return c;
 }

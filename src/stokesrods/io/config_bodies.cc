@@ -28,10 +28,10 @@ void ValidateBody(const Config& config, const std::string& p, const BodyConfig& 
   if (kMotions.count(body.motion) == 0)
     throw ConfigError(file, p + ".motion",
                       fmt::format("\"{}\" is not one of \"fixed\", \"free\", \"prescribed\"", body.motion));
-  if (body.motion == "free")
-    throw ConfigError(file, p + ".motion",
-                      "\"free\" bodies are not implemented in the coupled solve yet (issue 11); "
-                      "use \"fixed\" or \"prescribed\"");
+  if (body.motion == "free" && config.run.integrator == "bdf2")
+    throw ConfigError(file, "run.integrator",
+                      "\"bdf2\" does not take free bodies yet (their pose at the predictor); use "
+                      "\"euler\"");
   if (body.motion != "prescribed" && (body.velocity != Vec3::Zero() || body.angular_velocity != Vec3::Zero()))
     throw ConfigError(file, p + (body.velocity != Vec3::Zero() ? ".velocity" : ".angular_velocity"),
                       "only for motion = \"prescribed\"");
@@ -87,7 +87,8 @@ void ValidateBodiesAndWall(Config* config) {
     if (body.motion != "fixed")
       throw ConfigError(config->file, key,
                         fmt::format("rods on a \"{}\" body are not implemented yet (their clamp "
-                                    "would move with it); attach rods to a \"fixed\" body",
+                                    "would move with it, the motor turn against it); attach rods "
+                                    "to a \"fixed\" body",
                                     body.motion));
     if (rod.clamped_nodes < 1)
       throw ConfigError(config->file, key, "a rod on a body needs clamped_nodes ≥ 1");

@@ -24,9 +24,11 @@ std::string WriteFlowField(const Model& model, const State& state, const FlowFie
   VecX u;
   GatherNodeVelocities(model, state.velocity, VecX::Zero(state.velocity.size()), 1.0, &u);
   // The bodies' points follow the rods' nodes, with their rigid velocities.
-  const std::vector<BodySurface> bodies = BodySurfacesAt(model, state.time);
-  u.conservativeResize(3 * model.num_hydro_points());
-  u.tail(3 * model.num_body_points) = BodyPointVelocities(model, state.time);
+  // Free bodies' (U, Ω) are solved with their balance (the bordered mobility's last rows, 0 here).
+  const std::vector<BodySurface> bodies = BodySurfaces(model, state.bodies);
+  u.conservativeResize(model.hydro_size());
+  u.tail(model.hydro_size() - 3 * model.num_nodes).setZero();
+  u.segment(3 * model.num_nodes, 3 * model.num_body_points) = BodyPointVelocities(model, state.bodies);
   // The nodal forces on the fluid at the current positions and velocities, 𝕄 F = U: a dense LU
   // while 𝕄 is dense; with the matrix-free operator GMRES, preconditioned by the rods' own
   // self-mobilities (a dense 𝕄 of a hundred flagella would take 3 GB).
@@ -62,7 +64,7 @@ std::string WriteFlowField(const Model& model, const State& state, const FlowFie
       const Vec3 w = below ? Vec3(Vec3::Zero())
                            : Vec3(FluidVelocityAt(model.fluid, rods, forces.head(3 * model.num_nodes), x) +
                                   BodyBlobVelocityAt(model.fluid, bodies,
-                                                     forces.tail(3 * model.num_body_points), x));
+                                                     forces.segment(3 * model.num_nodes, 3 * model.num_body_points), x));
       points += fmt::format("{:.8g} {:.8g} {:.8g}\n", x.x(), x.y(), x.z());
       velocity += fmt::format("{:.8g} {:.8g} {:.8g}\n", w.x(), w.y(), w.z());
       csv += fmt::format("{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g}\n", x.x(), x.y(), x.z(), w.x(),

@@ -52,7 +52,7 @@ class Observer {
         for (int i = 0; i < rod.num_nodes(); ++i)
           contact.segment<3>(3 * (rod.node_offset + i)) =
               ws.contact_force.segment<3>(rod.dof_offset + NodeDof(i));
-      const VecX body_forces = ws.nonlocal_fluid ? VecX(ws.hydro_force.tail(3 * model_.num_body_points)) : VecX();
+      const VecX body_forces = ws.nonlocal_fluid ? VecX(ws.hydro_force.segment(3 * model_.num_nodes, 3 * model_.num_body_points)) : VecX();
       frames_->Write(model_, state, {{"hydrodynamic_force", &hydro}, {"contact_force", &contact}},
                      &body_forces);
     }

@@ -1,10 +1,10 @@
-// The cell bodies of a model in time (issue 11): pose, surface points and their velocities. A
-// "fixed" or "prescribed" body's motion is known, so its pose at time t is a closed form (no
-// state to integrate or checkpoint):
-//     c(t) = c(0) + U t,   R(t) = exp(t [Ω]×),   x_j(t) = c(t) + R(t) X_j,
-//     u_j = U + Ω × (x_j(t) − c(t)).
-// In the drag vector (3(M + P), sim/hydro_coupling.h) body k's points follow all rods' nodes from
-// M + body.point_offset; f there is the force of the fluid on the body's surface points.
+// The cell bodies of a model in time (issue 11): poses, surface points and their velocities.
+// A body's pose (State::bodies) is its centre c and rotation R; its points are x_j = c + R X_j.
+// A step of size h moves it rigidly with the (U, Ω) of the step, known ("fixed", "prescribed") or
+// solved ("free"):  c ← c + h U,  R ← exp(h [Ω]×) R  (exact for constant U, Ω).
+// In the hydrodynamic unknown f (3(M + P) + 6B, sim/hydro_coupling.h) body k's points follow all
+// rods' nodes from M + body.point_offset (the force of the fluid on each point), and the free
+// bodies' (U, Ω) come last, 6 per free body.
 #pragma once
 
 #include <vector>
@@ -12,20 +12,24 @@
 #include "stokesrods/common/types.h"
 #include "stokesrods/fluid/rigid_body.h"
 #include "stokesrods/sim/model.h"
+#include "stokesrods/sim/state.h"
 
 namespace stokesrods {
 
-Vec3 BodyCenterAt(const BodyModel& body, double time);
-Mat3 BodyRotationAt(const BodyModel& body, double time);
+/// The surfaces of all bodies at their poses, in model order; free bodies are marked so.
+std::vector<BodySurface> BodySurfaces(const Model& model, const std::vector<BodyPose>& poses);
 
-/// The surfaces of all bodies at `time` (their points and blobs), in model order.
-std::vector<BodySurface> BodySurfacesAt(const Model& model, double time);
+/// The known rigid velocities of all body points at their poses (3P) [m/s]: U + Ω × (x − c) of
+/// fixed and prescribed bodies; 0 for free ones (their motion is an unknown of the step).
+VecX BodyPointVelocities(const Model& model, const std::vector<BodyPose>& poses);
 
-/// The rigid velocities of all body points at `time` (3P) [m/s].
-VecX BodyPointVelocities(const Model& model, double time);
+/// (U, Ω) of body k in the step that gave the hydrodynamic unknown f (free: read from f).
+Vec6 BodyVelocity(const Model& model, int body, const VecX& f);
 
-/// Force and torque (about the centre at `time`) of the fluid on body k from the drag vector f
-/// (3(M + P)) [N, N·m].
-Vec6 BodyHydroLoad(const Model& model, int body, double time, const VecX& f);
+/// The poses after a step of size h with the velocities of f.
+void AdvanceBodies(const Model& model, double h, const VecX& f, std::vector<BodyPose>* poses);
+
+/// Force and torque (about the centre) of the fluid on body k at `pose` from f [N, N·m].
+Vec6 BodyHydroLoad(const Model& model, int body, const BodyPose& pose, const VecX& f);
 
 }  // namespace stokesrods

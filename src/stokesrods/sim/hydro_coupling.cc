@@ -114,9 +114,9 @@ HydroSolveReport HydroCoupling::Prepare(const Model& model, const VecX& q_start,
   return report;
 }
 
-void HydroCoupling::SetBodies(const Model& model, double time) {
-  bodies_ = BodySurfacesAt(model, time);
-  body_velocity_ = BodyPointVelocities(model, time);
+void HydroCoupling::SetBodies(const Model& model, const std::vector<BodyPose>& poses) {
+  bodies_ = BodySurfaces(model, poses);
+  body_velocity_ = BodyPointVelocities(model, poses);
 }
 
 void HydroCoupling::ForgetReuse(const VecX& drag_guess) {
@@ -142,7 +142,7 @@ void HydroCoupling::VelocityResidual(const Model& model, const VecX& q, const Ve
   mobility_->Apply(f, r_u);
   GatherNodeVelocities(model, q, q_start, h, &scratch_);  // fixed nodes: zero
   r_u->head(scratch_.size()) += scratch_;
-  r_u->tail(body_velocity_.size()) += body_velocity_;  // the bodies' known motion
+  r_u->segment(3 * model.num_nodes, body_velocity_.size()) += body_velocity_;  // known motion
 }
 
 bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,

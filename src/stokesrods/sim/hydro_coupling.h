@@ -32,6 +32,7 @@
 #include "stokesrods/fluid/mobility_operator.h"
 #include "stokesrods/sim/forces.h"
 #include "stokesrods/sim/model.h"
+#include "stokesrods/sim/state.h"
 #include "stokesrods/solver/banded_matrix.h"
 #include "stokesrods/solver/dense_lu.h"
 
@@ -52,7 +53,9 @@ class HydroCoupling {
   /// Prepare: their P points follow the M rod nodes in f and r_u (3(M + P)), with
   ///   r_u,body = 𝕄 f|_body + u_body = 0,   u_body = U + Ω × (x − c) known (fixed, prescribed);
   /// S has no rows there, so C = h𝕄 + S X extends by the bodies' rows and columns of h𝕄.
-  void SetBodies(const Model& model, double time);
+  /// Free bodies add 6 unknowns (U, Ω) each after the points, and 6 rows r_b = Gᵀ f (their
+  /// balance of force and torque) to r_u: the bordered mobility of fluid/rigid_body.h.
+  void SetBodies(const Model& model, const std::vector<BodyPose>& poses);
 
   /// Takes 𝕄 at q_start; for the explicit coupling also solves for the drag of v_start.
   HydroSolveReport Prepare(const Model& model, const VecX& q_start, const VecX& v_start);

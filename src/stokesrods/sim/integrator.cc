@@ -1,5 +1,7 @@
 #include "stokesrods/sim/integrator.h"
 
+#include "stokesrods/sim/bodies.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -18,7 +20,7 @@ Workspace::Workspace(const Model& model) : local_forces(MakeLocalForces(model)) 
   for (const RodModel& rod : model.rods) jacobian.emplace_back(rod.num_dofs(), 10);
   if (nonlocal_fluid) {
     hydro.Init(model);
-    hydro_force = hydro_force_try = VecX::Zero(3 * model.num_hydro_points());
+    hydro_force = hydro_force_try = VecX::Zero(model.hydro_size());
   }
 }
 
@@ -76,6 +78,12 @@ double VelocityResidualNorm(const Model& model, const VecX& r_u) {
       norm = std::max(norm, drag * body.regularization *
                                 r_u.segment<3>(3 * (model.num_nodes + body.point_offset + j))
                                     .cwiseAbs().maxCoeff());
+  for (const BodyModel& body : model.bodies) {  // a free body's balance: force, torque / radius
+    if (body.free_index < 0) continue;
+    const Vec6 r = r_u.segment<6>(3 * model.num_hydro_points() + 6 * body.free_index);
+    norm = std::max({norm, r.head<3>().cwiseAbs().maxCoeff(),
+                     r.tail<3>().cwiseAbs().maxCoeff() / body.radius});
+  }
   return norm;
 }
 
@@ -302,7 +310,7 @@ NewtonReport SolveNewton(const Model& model, const State& start, double h, Works
 void PrepareStep(const Model& model, const State& start, Workspace* ws) {
   for (const auto& f : ws->local_forces) f->Prepare(model, start.q);
   if (ws->nonlocal_fluid) {
-    if (!model.bodies.empty()) ws->hydro.SetBodies(model, start.time);
+    if (!model.bodies.empty()) ws->hydro.SetBodies(model, start.bodies);
     ws->hydro.Prepare(model, start.q, start.velocity);
     if (model.coupling == FluidCoupling::kExplicit) ws->hydro_force = ws->hydro.explicit_force();
   }
@@ -332,6 +340,7 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
   State& start = ws->step_start;
   start.time = state->time;
   start.step = state->step;
+  start.bodies = state->bodies;
   if (bdf2) {
     start.q = (4.0 * state->q - ws->previous_q) / 3.0;
     start.velocity = (4.0 * state->velocity - ws->previous_velocity) / 3.0;
@@ -349,7 +358,9 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
     State& geometry = ws->step_geometry;  // where the step's mobility and local drag are taken
     geometry.q = ws->q;
     geometry.velocity = state->velocity;
-    geometry.time = state->time + h;  // the predictor's time (the bodies' pose)
+    geometry.time = state->time + h;  // the predictor's time: the bodies' (known) poses there
+    geometry.bodies = state->bodies;
+    AdvanceBodies(model, h, ws->hydro_force, &geometry.bodies);
     PrepareStep(model, geometry, ws);
   } else {
     PrepareStep(model, start, ws);
@@ -381,7 +392,7 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
       ws->factors_h = he;
       ws->factors_age = 0;
     }
-    const VecX no_slip = VecX::Zero(ws->nonlocal_fluid ? 3 * model.num_hydro_points() : 0);
+    const VecX no_slip = VecX::Zero(ws->nonlocal_fluid ? model.hydro_size() : 0);
     const LinearResponse respond = [&](const VecX& force, VecX* dq) {
       VecX df, du;  // −J⁻¹(−F) = J⁻¹ F, the drag responding with the rods
       report.krylov_iterations += NewtonCorrection(model, he, -force, no_slip, ws, dq, &df, &du);
@@ -404,6 +415,7 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
   ws->previous_h = h;
   state->velocity = (ws->q - start.q) / he;
   state->q = ws->q;
+  AdvanceBodies(model, h, ws->hydro_force, &state->bodies);
   std::swap(start.rods, ws->frames);  // the new frames go to the state by give_back;
                                       // ws->frames is rewritten by the next Evaluate
   state->time += h;

@@ -69,8 +69,10 @@ void FinalizeLayout(Model* model) {
   model->num_nodes = nodes;
   model->force_scale = force_scale;
   int points = 0;
+  model->num_free_bodies = 0;
   for (BodyModel& body : model->bodies) {
     body.point_offset = points;
+    body.free_index = body.motion == BodyMotion::kFree ? model->num_free_bodies++ : -1;
     points += body.num_points();
     // Without rods the bodies set the scales: their size and their Stokes drag.
     if (!model->rods.empty()) continue;

@@ -61,9 +61,10 @@ struct RodModel {
 };
 
 /// A rigid cell body (issue 11): its surface as regularized Stokeslets (fluid/rigid_body.h),
-/// more sources and targets of the mobility beside the rods' nodes. Its motion is known:
-/// "fixed", or "prescribed" with constant U and Ω (the pose at time t follows in closed form).
-enum class BodyMotion { kFixed, kPrescribed };
+/// more sources and targets of the mobility beside the rods' nodes. Its motion is "fixed",
+/// "prescribed" (constant U and Ω) or "free" (U and Ω unknowns of the step, with the balance of
+/// the fluid's force and torque on it; sim/hydro_coupling.h).
+enum class BodyMotion { kFixed, kPrescribed, kFree };
 
 struct BodyModel {
   double radius = 0.0;                     ///< a [m]
@@ -74,6 +75,7 @@ struct BodyModel {
   Matrix3X surface;                        ///< surface points relative to the centre at t = 0 [m]
   double regularization = 0.0;             ///< ε of the surface blobs [m]
   int point_offset = 0;                    ///< first of its points after all rods' nodes
+  int free_index = -1;                     ///< among the free bodies (their (U, Ω) unknowns)
 
   int num_points() const { return static_cast<int>(surface.cols()); }
 };
@@ -118,9 +120,13 @@ struct Model {
 
   int num_dofs = 0;
   int num_nodes = 0;
-  int num_body_points = 0;           ///< P: the drag vector has 3(M + P) entries
+  int num_body_points = 0;           ///< P
+  int num_free_bodies = 0;           ///< B: the drag vector has 3(M + P) + 6B entries
 
   int num_hydro_points() const { return num_nodes + num_body_points; }
+  /// Entries of the implicit coupling's hydrodynamic unknown: the forces at the rods' nodes and
+  /// the bodies' points, then (U, Ω) of each free body.
+  int hydro_size() const { return 3 * num_hydro_points() + 6 * num_free_bodies; }
 };
 
 /// Fills dof_offset/node_offset, num_dofs/num_nodes, force_scale and length_scale from the rods,

@@ -68,13 +68,13 @@ std::vector<double> CalcTimeseriesRow(const Model& model, const State& state, co
   row.insert(row.end(), {report.contact.max_penetration,
                          static_cast<double>(report.newton_iterations)});
   for (int k = 0; k < static_cast<int>(model.bodies.size()); ++k) {
-    const BodyModel& body = model.bodies[static_cast<size_t>(k)];
-    const Vec3 c = BodyCenterAt(body, state.time);
-    // The fluid's force of the last step (the drag vector holds the bodies' points after the rods').
-    const Vec3 f = ws.hydro_force.size() == 3 * model.num_hydro_points()
-                       ? Vec3(BodyHydroLoad(model, k, state.time, ws.hydro_force).head<3>())
-                       : Vec3::Zero();
-    const Vec3& w = body.angular_velocity;
+    const BodyPose& pose = state.bodies[static_cast<size_t>(k)];
+    const Vec3 c = pose.center;
+    // The fluid's force and the body's angular velocity of the last step (sim/bodies.h).
+    const bool solved = ws.hydro_force.size() == model.hydro_size();
+    const Vec3 f = solved ? Vec3(BodyHydroLoad(model, k, pose, ws.hydro_force).head<3>()) : Vec3::Zero();
+    const Vec3 w = solved ? Vec3(BodyVelocity(model, k, ws.hydro_force).tail<3>())
+                          : Vec3(model.bodies[static_cast<size_t>(k)].angular_velocity);
     row.insert(row.end(), {c.x(), c.y(), c.z(), f.x(), f.y(), f.z(), w.x(), w.y(), w.z()});
   }
   return row;

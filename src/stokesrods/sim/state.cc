@@ -22,6 +22,7 @@ State MakeRestState(const Model& model) {
     frames.reference_twist = ReferenceTwists(frames.frames, frames.tangents, VecX());
     state.rods.push_back(std::move(frames));
   }
+  for (const BodyModel& body : model.bodies) state.bodies.push_back({body.center, Mat3::Identity()});
   return state;
 }
 

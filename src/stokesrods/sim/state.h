@@ -16,12 +16,19 @@ struct RodFrames {
   VecX reference_twist;           ///< per node (interior used) [rad]
 };
 
+/// Where a rigid body is: its centre and its rotation from the body's rest frame.
+struct BodyPose {
+  Vec3 center = Vec3::Zero();
+  Mat3 rotation = Mat3::Identity();
+};
+
 struct State {
   double time = 0.0;     ///< [s]
   long step = 0;
   VecX q;                ///< all DOFs of all rods
   VecX velocity;         ///< dq/dt
   std::vector<RodFrames> rods;
+  std::vector<BodyPose> bodies;   ///< one per model body
 };
 
 /// Node positions of rod r of the global vector q (3 × N).
