@@ -232,6 +232,7 @@ Model BuildModel(const Config& config) {
     rod.twisting_stiffness = shear * 2.0 * inertia;  // J = π r0⁴ / 2 = 2 I
     rod.rest_positions = RestShape(rc);
     rod.clamped_nodes = rc.clamped_nodes;
+    rod.body = rc.body - 1;
     rod.axis_length = rc.axis_length;
     rod.helix_radius = rc.shape == "helix" ? rc.helix_radius : 0.0;
     // ω about +ẑ; omega_bar = ω μ l0⁴ / EI (SPEC).

@@ -84,7 +84,7 @@ void ValidateBodiesAndWall(Config* config) {
                         fmt::format("body {} does not exist (there are {} [[bodies]])", rod.body,
                                     config->bodies.size()));
     const BodyConfig& body = config->bodies[static_cast<std::size_t>(rod.body - 1)];
-    if (body.motion != "fixed")
+    if (body.motion == "free")
       throw ConfigError(config->file, key,
                         fmt::format("rods on a \"{}\" body are not implemented yet (their clamp "
                                     "would move with it, the motor turn against it); attach rods "

@@ -69,7 +69,7 @@ const std::map<std::string, std::string>& Meanings() {
       {"rods.loads", "constant point forces, e.g. [{node = 64, force = [0, 0, -1e-3]}]"},
       {"rods.loads[].node", "node of the load, from 0"},
       {"rods.loads[].force", "force [N]"},
-      {"rods.body", "the body (from 1) whose frame holds the clamped nodes and against which the motor turns; 0: none (a \"fixed\" body only, for now)"},
+      {"rods.body", "the body (from 1) whose frame holds the clamped nodes and against which the motor turns; 0: none (a \"fixed\" or \"prescribed\" body; not yet a \"free\" one)"},
       {"bodies.shape", "\"sphere\""},
       {"bodies.radius", "a [m]"},
       {"bodies.center", "centre at the start [m]"},

@@ -1,6 +1,9 @@
 #include "stokesrods/sim/bodies.h"
 
+#include <cmath>
+
 #include "stokesrods/common/assert.h"
+#include "stokesrods/rod/frames.h"
 
 namespace stokesrods {
 
@@ -51,6 +54,28 @@ void AdvanceBodies(const Model& model, double h, const VecX& f, std::vector<Body
     if (angle > 0.0)
       pose.rotation = Eigen::AngleAxisd(angle, v.tail<3>().normalized()).toRotationMatrix() *
                       pose.rotation;
+  }
+}
+
+void DriveBodyClamps(const Model& model, const std::vector<BodyPose>& from,
+                     const std::vector<BodyPose>& to, VecX* q) {
+  for (const RodModel& rod : model.rods) {
+    if (rod.body < 0) continue;
+    const auto k = static_cast<std::size_t>(rod.body);
+    SR_ASSERT(model.bodies[k].motion != BodyMotion::kFree, "rods on free bodies are not built");
+    const Mat3 turn = to[k].rotation * from[k].rotation.transpose();
+    if (turn == Mat3::Identity() && to[k].center == from[k].center) continue;
+    const Vec3 t_old = (q->segment<3>(rod.dof_offset + NodeDof(1)) -
+                        q->segment<3>(rod.dof_offset + NodeDof(0))).normalized();
+    for (int i = 0; i < rod.clamped_nodes; ++i) {
+      auto x = q->segment<3>(rod.dof_offset + NodeDof(i));
+      x = to[k].center + turn * (Vec3(x) - from[k].center);
+    }
+    if (rod.clamped_nodes < 2) continue;
+    const Vec3 t_new = turn * t_old, u = t_old.unitOrthogonal();
+    const Vec3 transported = ParallelTransport(u, t_old, t_new), turned = turn * u;
+    (*q)(rod.dof_offset + TwistDof(0)) +=
+        std::atan2(t_new.dot(transported.cross(turned)), transported.dot(turned));
   }
 }
 

@@ -29,6 +29,13 @@ Vec6 BodyVelocity(const Model& model, int body, const VecX& f);
 /// The poses after a step of size h with the velocities of f.
 void AdvanceBodies(const Model& model, double h, const VecX& f, std::vector<BodyPose>* poses);
 
+/// Moves the clamps of rods on moving (prescribed) bodies from the poses `from` to `to`: the
+/// clamped nodes rigidly with the body, and θ0 by the body's spin about the first edge (the angle
+/// about the new tangent between the parallel transport of the old frame and its rigid rotation),
+/// on top of the motor's turn relative to the body (DriveBoundaryConditions).
+void DriveBodyClamps(const Model& model, const std::vector<BodyPose>& from,
+                     const std::vector<BodyPose>& to, VecX* q);
+
 /// Force and torque (about the centre) of the fluid on body k at `pose` from f [N, N·m].
 Vec6 BodyHydroLoad(const Model& model, int body, const BodyPose& pose, const VecX& f);
 

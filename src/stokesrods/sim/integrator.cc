@@ -329,6 +329,11 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
   for (const RodModel& rod : model.rods)
     for (int k : rod.fixed_dofs) ws->q(rod.dof_offset + k) = state->q(rod.dof_offset + k);
   DriveBoundaryConditions(model, h, &ws->q);
+  if (!model.bodies.empty()) {  // clamps on moving bodies go with them
+    std::vector<BodyPose> next = state->bodies;
+    AdvanceBodies(model, h, ws->hydro_force, &next);
+    DriveBodyClamps(model, state->bodies, next, &ws->q);
+  }
 
   // Every step is solved in implicit Euler's form, v(q) = (q − q̃)/h_e and M (v(q) − ṽ)/h_e =
   // F(q, v(q)): implicit Euler has q̃ = q_k, ṽ = q̇_k, h_e = h; BDF2 (from the second step at an

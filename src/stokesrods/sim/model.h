@@ -42,6 +42,9 @@ struct RodModel {
   int clamped_nodes = 0;        ///< 0, 1 or 2 leading nodes held fixed (2 also holds θ0)
   double twist_rate = 0.0;      ///< dθ0/dt [rad/s] imposed when clamped_nodes == 2
   double omega = 0.0;           ///< rotation rate about +ẑ as configured [rad/s]
+  /// The body (model index) that holds the clamp and against which θ0 turns; −1: none (fixed in
+  /// space). A prescribed body carries the clamped nodes and θ0 with it (sim/bodies.h).
+  int body = -1;
   std::vector<int> fixed_dofs;  ///< local DOFs held at their current value, sorted
   std::vector<PointLoad> loads;
 
