@@ -96,6 +96,18 @@ def write_csv(path, header, rows):
     log("wrote", path, f"({len(rows)} rows)")
 
 
+def switch_bracket(points):
+    """points: [(value, yes)]. The rule of `stokesrods analyze`: (last "no" below the switch, first
+    value from which every larger one is "yes"]; returns (below, above, monotone), None where open."""
+    points = sorted(points)
+    first_yes = len(points)
+    while first_yes > 0 and points[first_yes - 1][1]:
+        first_yes -= 1
+    above = points[first_yes][0] if first_yes < len(points) else None
+    below = points[first_yes - 1][0] if first_yes > 0 else None
+    return below, above, not any(yes for _, yes in points[:first_yes])
+
+
 def crossing_marker(ax, x, y, crossed):
     """One case of a crossing diagram: ● crossed (Δb ≤ 0 at the end), △ not."""
     ax.plot(x, y, "o" if crossed else "^", ms=5, mfc="tab:blue" if crossed else "none",
