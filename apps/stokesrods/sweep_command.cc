@@ -80,17 +80,10 @@ pid_t SpawnCase(const Sweep& sweep, const SweepCase& c, bool resume, int threads
   return pid;
 }
 
-std::string ReadText(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 CaseRecord RecordOfExit(const SweepCase& c, int wait_status, double wall) {
   const int code = WIFEXITED(wait_status) ? WEXITSTATUS(wait_status) : 0;
   const int signal = WIFSIGNALED(wait_status) ? WTERMSIG(wait_status) : 0;
-  return MakeCaseRecord(code, signal, wall, ReadText(fs::path(c.output_dir) / "summary.json"));
+  return MakeCaseRecord(code, signal, wall, ReadFileText((fs::path(c.output_dir) / "summary.json").string()).value_or(""));
 }
 
 std::string Hms(double seconds) {

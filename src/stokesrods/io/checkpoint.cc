@@ -126,14 +126,9 @@ void SaveCheckpoint(const std::string& path, const Model& model, const Checkpoin
 }
 
 Checkpoint LoadCheckpoint(const std::string& path, const Model& model) {
-  std::string text;
-  {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw IoError(fmt::format("{}: cannot open the checkpoint", path));
-    std::stringstream s;
-    s << in.rdbuf();
-    text = s.str();
-  }
+  const std::optional<std::string> file = ReadFileText(path);
+  if (!file) throw IoError(fmt::format("{}: cannot open the checkpoint", path));
+  const std::string& text = *file;
   Reader r(path, text);
   char magic[sizeof kMagic];
   if (text.size() < sizeof kMagic || (r.Raw(magic, sizeof magic), std::memcmp(magic, kMagic, sizeof kMagic) != 0))

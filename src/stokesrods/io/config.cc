@@ -1,3 +1,4 @@
+#include "stokesrods/io/writers.h"
 #include "stokesrods/io/config.h"
 
 #include <cmath>
@@ -477,11 +478,9 @@ Config ParseConfig(const std::string& toml_text, const std::string& file,
 }
 
 Config LoadConfig(const std::string& path, const std::vector<std::string>& overrides) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError(path, "", "cannot open the file");
-  std::stringstream text;
-  text << in.rdbuf();
-  return ParseConfig(text.str(), path, overrides);
+  const std::optional<std::string> text = ReadFileText(path);
+  if (!text) throw ConfigError(path, "", "cannot open the file");
+  return ParseConfig(*text, path, overrides);
 }
 
 std::vector<ConfigKey> ListConfigKeys() {

@@ -280,11 +280,9 @@ Sweep ReadSweepJson(const std::string& dir) {
 }
 
 Sweep LoadSweep(const std::string& path, const std::string& output) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError(path, "", "cannot open the file");
-  std::stringstream text;
-  text << in.rdbuf();
-  return ParseSweep(text.str(), path, fs::path(path).parent_path().string(), output);
+  const std::optional<std::string> text = ReadFileText(path);
+  if (!text) throw ConfigError(path, "", "cannot open the file");
+  return ParseSweep(*text, path, fs::path(path).parent_path().string(), output);
 }
 
 std::vector<std::string> CaseArguments(const Sweep& sweep, const SweepCase& c, bool resume) {

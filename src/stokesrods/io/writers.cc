@@ -6,6 +6,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include <fmt/format.h>
 
@@ -165,6 +166,14 @@ void FrameWriter::Write(const Model& model, const State& state,
   WriteFileAtomically((fs::path(dir_) / body_name).string(),
                       BodyFrameXml(model, state, body_forces, binary_));
   AddToIndex(dir_, "bodies.pvd", state.time, body_name, &body_entries_);
+}
+
+std::optional<std::string> ReadFileText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return std::nullopt;
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
 }
 
 }  // namespace stokesrods

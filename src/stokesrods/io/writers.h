@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <stdexcept>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -70,5 +71,9 @@ void TruncateCsv(const std::string& path, long rows);
 
 /// Writes text to `path` through a temporary file and a rename (never a half-written file).
 void WriteFileAtomically(const std::string& path, const std::string& text);
+
+/// The whole content of a file (bytes as they are), or nothing if it cannot be opened: the
+/// caller says which error that is for it.
+std::optional<std::string> ReadFileText(const std::string& path);
 
 }  // namespace stokesrods

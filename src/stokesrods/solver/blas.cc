@@ -39,30 +39,42 @@ void Gemv(const Eigen::MatrixXf& a, const Eigen::VectorXf& x, Eigen::VectorXf* y
     GemvRows(a, first, std::min(kRows, m - first), x.data(), y->data() + first);
 }
 
-void GemvRows(const Eigen::MatrixXf& a, Eigen::Index first, Eigen::Index rows, const float* x,
-              float* y) {
-  const int m = static_cast<int>(rows), n = static_cast<int>(a.cols());
-  const int lda = static_cast<int>(a.rows()), one = 1;
+
+namespace {
+
+void Gemv(int m, int n, const float* a, int lda, const float* x, float* y) {
   const float alpha = 1.0f, beta = 0.0f;
-  if (m == 0) return;
-  if (n == 0) {
-    for (int i = 0; i < m; ++i) y[i] = 0.0f;
+  const int one = 1;
+  sgemv_("N", &m, &n, &alpha, a, &lda, x, &one, &beta, y, &one, 1);
+}
+void Gemv(int m, int n, const double* a, int lda, const double* x, double* y) {
+  const double alpha = 1.0, beta = 0.0;
+  const int one = 1;
+  dgemv_("N", &m, &n, &alpha, a, &lda, x, &one, &beta, y, &one, 1);
+}
+
+template <typename Scalar>
+void Rows(const Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>& a, Eigen::Index first,
+          Eigen::Index rows, const Scalar* x, Scalar* y) {
+  if (rows == 0) return;
+  if (a.cols() == 0) {
+    std::fill(y, y + rows, Scalar(0));
     return;
   }
-  sgemv_("N", &m, &n, &alpha, a.data() + first, &lda, x, &one, &beta, y, &one, 1);
+  Gemv(static_cast<int>(rows), static_cast<int>(a.cols()), a.data() + first,
+       static_cast<int>(a.rows()), x, y);
 }
+
+}  // namespace
 
 void GemvRows(const Eigen::MatrixXd& a, Eigen::Index first, Eigen::Index rows, const double* x,
               double* y) {
-  const int m = static_cast<int>(rows), n = static_cast<int>(a.cols());
-  const int lda = static_cast<int>(a.rows()), one = 1;
-  const double alpha = 1.0, beta = 0.0;
-  if (m == 0) return;
-  if (n == 0) {
-    for (int i = 0; i < m; ++i) y[i] = 0.0;
-    return;
-  }
-  dgemv_("N", &m, &n, &alpha, a.data() + first, &lda, x, &one, &beta, y, &one, 1);
+  Rows(a, first, rows, x, y);
+}
+
+void GemvRows(const Eigen::MatrixXf& a, Eigen::Index first, Eigen::Index rows, const float* x,
+              float* y) {
+  Rows(a, first, rows, x, y);
 }
 
 }  // namespace stokesrods
