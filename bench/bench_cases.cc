@@ -3,6 +3,7 @@
 // memory is its own; bench/run_table.py runs the cases and prints the table (bench/README.md).
 //
 //   bench_cases CASE [--steps K] [--warmup W] [--set dotted.key=value]...
+//   bench_cases CASE --print-config     (the case as a configuration file, for stokesrods run)
 //
 // Builds the case's configuration as TOML text, applies the --set overrides (SPEC syntax), runs W
 // untimed steps from rest, then K steps each timed with steady_clock, and prints one line of JSON.
@@ -132,6 +133,7 @@ struct Options {
   int steps = kDefaultSteps;
   int warmup = kDefaultWarmup;
   std::vector<std::string> overrides;
+  bool print_config = false;  ///< print the case's TOML (before overrides) and exit
 };
 
 void PrintUsage(std::FILE* to) {
@@ -139,6 +141,7 @@ void PrintUsage(std::FILE* to) {
   for (const std::string& n : CaseNames()) names += " " + n;
   fmt::print(to,
              "usage: bench_cases CASE [--steps K] [--warmup W] [--set dotted.key=value]...\n"
+             "       bench_cases CASE --print-config\n"
              "cases:{}\n",
              names);
 }
@@ -177,6 +180,8 @@ std::optional<Options> ParseArgs(int argc, char** argv) {
       o.overrides.push_back(*v);
     } else if (arg.rfind("--set=", 0) == 0) {
       o.overrides.push_back(arg.substr(6));
+    } else if (arg == "--print-config") {
+      o.print_config = true;
     } else if (arg == "-h" || arg == "--help") {
       PrintUsage(stdout);
       std::exit(0);
@@ -293,6 +298,10 @@ int main(int argc, char** argv) {
   j["case"] = options->case_name;
   int code = 0;
   const std::optional<CaseSpec> spec = FindCase(options->case_name);
+  if (spec && options->print_config) {
+    fmt::print("{}", CaseToml(*spec));
+    return 0;
+  }
   if (!spec) {
     j["ok"] = false;
     j["message"] = fmt::format("unknown case '{}'", options->case_name);

@@ -209,7 +209,8 @@ TEST(Jacobian, ImplicitNonlocalDragTwoHelicesKrylov) {
 // The matrix-free 𝕄 at a far-field tolerance of 1e-10 against the dense reference.
 TEST(Jacobian, ImplicitNonlocalDragTwoHelicesMatrixFree) {
   CheckImplicitNonlocalDrag(
-      "mobility = \"matrix_free\"\nfar_field_tolerance = 1e-10\nkrylov_tolerance = 1e-12", 1e-8);
+      "mobility = \"matrix_free\"\nfar_field_tolerance = 1e-10\nfast_sum_tolerance = 1e-10\n"
+      "krylov_tolerance = 1e-12", 1e-8);
 }
 
 }  // namespace

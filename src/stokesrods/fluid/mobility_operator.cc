@@ -3,7 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <unordered_map>
+
+#include <Eigen/Geometry>
 
 #include "stokesrods/common/assert.h"
 #include "stokesrods/fluid/rss.h"
@@ -21,6 +22,23 @@ void MobilityOperator::SetLayout(const std::vector<HydroRod>& rods) {
 }
 
 namespace {
+
+// flags[k] = 1 where segment first + k is near p: |p − closest point|² + ε² < δ²|v|².
+__attribute__((target_clones("avx512f", "avx2", "default")))
+void MarkNearSegments(const Vec3& p, int first, int count, const double* ax, const double* ay,
+                      const double* az, const double* vx, const double* vy, const double* vz,
+                      const double* inv_v2, const double* e2, const double* reach2,
+                      unsigned char* flags) {
+  const double px = p.x(), py = p.y(), pz = p.z();
+#pragma omp simd
+  for (int k = 0; k < count; ++k) {
+    const int s = first + k;
+    const double dx = px - ax[s], dy = py - ay[s], dz = pz - az[s];
+    const double t = std::clamp((dx * vx[s] + dy * vy[s] + dz * vz[s]) * inv_v2[s], 0.0, 1.0);
+    const double rx = dx - t * vx[s], ry = dy - t * vy[s], rz = dz - t * vz[s];
+    flags[k] = rx * rx + ry * ry + rz * rz + e2[s] < reach2[s];
+  }
+}
 
 class DenseMobility final : public MobilityOperator {
  public:
@@ -71,7 +89,8 @@ class DenseMobility final : public MobilityOperator {
 class MatrixFreeRssMobility final : public MobilityOperator {
  public:
   MatrixFreeRssMobility(const FluidParams& params, const MobilityOptions& options)
-      : params_(params), options_(options), split_(ChooseNearFarSplit(options.tolerance)) {}
+      : params_(params), options_(options), split_(ChooseNearFarSplit(std::max(options.tolerance, options.fast_sum_tolerance),
+                                       options.fast_sum_near_delta)) {}
 
   void Update(const std::vector<HydroRod>& rods) override;
   void Apply(const VecX& force, VecX* velocity) const override;
@@ -122,21 +141,16 @@ void MatrixFreeRssMobility::Update(const std::vector<HydroRod>& rods) {
     for (int j = 0; j + 1 < x.cols(); ++j) segments_.push_back({first + j, eps, r});
   }
   if (!far_) {
-    // Direct far sum below the size where the FMM may pay; above it the far field is only as
-    // accurate as the FMM's tolerance, so the quadrature need not be better either, and the
-    // near zone (exact closed forms, once per step) can shrink: Gauss points cost far less
-    // through the FMM than through the direct sum.
-    const double pairs = static_cast<double>(segments_.size()) * split_.gauss_points * m;
-    if (pairs < options_.direct_sum_below) {
-      far_ = MakeDirectStokesletSum();
-    } else {
-      far_ = MakeFastStokesletSum(
-          {.tolerance = options_.fast_sum_tolerance,
-           .direct_below_pairs = static_cast<std::int64_t>(options_.direct_sum_below),
-           .choose_by_cost = options_.fast_sum_by_cost});
-      split_ = ChooseNearFarSplit(std::max(options_.tolerance, options_.fast_sum_tolerance),
-                                  options_.fast_sum_near_delta);
-    }
+    // One accuracy at every size: the far field is as accurate as the fast sum's tolerance, so
+    // the quadrature need not be better either, and the near zone (exact closed forms, once per
+    // step) can shrink. The fast sum adds up directly (in single precision from 1e-4) below
+    // direct_sum_below pairs or where its cost model says the tree would not pay.
+    far_ = MakeFastStokesletSum(
+        {.tolerance = options_.fast_sum_tolerance,
+         .direct_below_pairs = static_cast<std::int64_t>(options_.direct_sum_below),
+         .choose_by_cost = options_.fast_sum_by_cost});
+    split_ = ChooseNearFarSplit(std::max(options_.tolerance, options_.fast_sum_tolerance),
+                                options_.fast_sum_near_delta);
   }
   const double* alpha = nullptr;
   const double* weight = nullptr;
@@ -155,25 +169,29 @@ void MatrixFreeRssMobility::Update(const std::vector<HydroRod>& rods) {
   FindNearPairs(nodes_);
 }
 
-// Near pairs by a uniform grid of segment midpoints, cells of the near radius plus half the
-// longest segment, so that every segment within the near radius of a target has its midpoint in
-// the 27 cells around the target.
+// Near pairs rod by rod: a rod whose bounding box, grown by the longest near reach, does not
+// hold the target has no near segment; otherwise every segment of the rod is tested at once
+// (vectorized over its segments). Near segments come out in rod order.
 void MatrixFreeRssMobility::FindNearPairs(const Matrix3X& targets) {
-  double longest = 0.0;
-  for (const Segment& s : segments_)
-    longest = std::max(longest, (nodes_.col(s.a + 1) - nodes_.col(s.a)).norm());
-  const double reach = split_.near_delta * longest;  // d < δ_near L ≤ this
-  const double cell = reach + 0.5 * longest;
-  auto key = [&](const Vec3& p, int dx, int dy, int dz) {
-    const auto c = [&](double v, int d) {
-      return static_cast<std::int64_t>(std::floor(v / cell)) + d + (1 << 20);
-    };
-    return (c(p.x(), dx) << 42) | (c(p.y(), dy) << 21) | c(p.z(), dz);
-  };
-  std::unordered_map<std::int64_t, std::vector<int>> grid;
-  for (std::size_t s = 0; s < segments_.size(); ++s) {
-    const Vec3 mid = 0.5 * (nodes_.col(segments_[s].a) + nodes_.col(segments_[s].a + 1));
-    grid[key(mid, 0, 0, 0)].push_back(static_cast<int>(s));
+  const double delta2 = split_.near_delta * split_.near_delta;
+  const int num_segments = static_cast<int>(segments_.size());
+  // Per segment (structure of arrays): x_a, v = x_b − x_a, 1/|v|², ε², δ²|v|².
+  std::vector<double> ax(num_segments), ay(num_segments), az(num_segments), vx(num_segments),
+      vy(num_segments), vz(num_segments), inv_v2(num_segments), e2(num_segments),
+      reach2(num_segments);
+  std::vector<Eigen::AlignedBox3d> boxes(static_cast<size_t>(num_rods()));
+  std::vector<double> box_reach(static_cast<size_t>(num_rods()), 0.0);
+  for (int s = 0; s < num_segments; ++s) {
+    const Segment& seg = segments_[static_cast<size_t>(s)];
+    const Vec3 xa = nodes_.col(seg.a), v = nodes_.col(seg.a + 1) - xa;
+    ax[s] = xa.x(), ay[s] = xa.y(), az[s] = xa.z(), vx[s] = v.x(), vy[s] = v.y(), vz[s] = v.z();
+    inv_v2[s] = 1.0 / v.squaredNorm();
+    e2[s] = seg.eps * seg.eps;
+    reach2[s] = delta2 * v.squaredNorm();
+    boxes[static_cast<size_t>(seg.rod)].extend(xa);
+    boxes[static_cast<size_t>(seg.rod)].extend(Vec3(xa + v));
+    box_reach[static_cast<size_t>(seg.rod)] =
+        std::max(box_reach[static_cast<size_t>(seg.rod)], std::sqrt(reach2[s]));
   }
   // The exact near pairs minus the far sum's rule, by rows of RssRowKernel over the range of a
   // rod's segments that are near a target (vectorized; columns of segments in the range that
@@ -188,27 +206,24 @@ void MatrixFreeRssMobility::FindNearPairs(const Matrix3X& targets) {
   std::vector<std::vector<std::pair<int, Mat3>>> per_target(static_cast<size_t>(m));
 #pragma omp parallel
   {
-    std::vector<int> near;          // global segment indices near the target
+    std::vector<int> near;          // global segment indices near the target, in rod order
+    std::vector<unsigned char> flags;
     std::vector<double> table;
     std::vector<char> is_near;
 #pragma omp for schedule(dynamic, 16)
     for (int t = 0; t < m; ++t) {
       const Vec3 p = targets.col(t);
       near.clear();
-      for (int dx = -1; dx <= 1; ++dx)
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dz = -1; dz <= 1; ++dz) {
-            const auto it = grid.find(key(p, dx, dy, dz));
-            if (it == grid.end()) continue;
-            for (int s : it->second) {
-              const Segment& seg = segments_[static_cast<size_t>(s)];
-              const Vec3 xa = nodes_.col(seg.a), v = nodes_.col(seg.a + 1) - xa;
-              const double alpha = std::clamp((p - xa).dot(v) / v.squaredNorm(), 0.0, 1.0);
-              const double d2 = (p - xa - alpha * v).squaredNorm() + seg.eps * seg.eps;
-              if (d2 < split_.near_delta * split_.near_delta * v.squaredNorm()) near.push_back(s);
-            }
-          }
-      std::sort(near.begin(), near.end());
+      for (int r = 0; r < num_rods(); ++r) {
+        if (boxes[static_cast<size_t>(r)].exteriorDistance(p) >= box_reach[static_cast<size_t>(r)])
+          continue;
+        const int first = node_offset(r) - r, count = node_offset(r + 1) - node_offset(r) - 1;
+        flags.resize(static_cast<size_t>(count));
+        MarkNearSegments(p, first, count, ax.data(), ay.data(), az.data(), vx.data(), vy.data(),
+                         vz.data(), inv_v2.data(), e2.data(), reach2.data(), flags.data());
+        for (int k = 0; k < count; ++k)
+          if (flags[static_cast<size_t>(k)]) near.push_back(first + k);
+      }
       std::vector<std::pair<int, Mat3>>& blocks = per_target[static_cast<size_t>(t)];
       for (std::size_t i = 0; i < near.size();) {  // one rod at a time (segments in rod order)
         const int rod = segments_[static_cast<size_t>(near[i])].rod;

@@ -33,19 +33,21 @@ enum class MobilityKind { kDense, kMatrixFree };
 
 struct MobilityOptions {
   MobilityKind kind = MobilityKind::kDense;
-  /// Matrix-free: bound on the relative error of each far segment–node interaction (quadrature)
-  /// and of the fast sum [–].
+  /// Matrix-free: bound on the relative error of each far segment–node interaction (quadrature).
+  /// The far field as a whole is accurate to max(tolerance, fast_sum_tolerance) at every size
+  /// (the quadrature need not be finer than the sum it feeds) [–].
   double tolerance = 1e-8;
-  /// Matrix-free: the far-field sum runs directly below this many source–target pairs; above,
-  /// the FMM (stokeslet_sum.h) decides by its cost model.
+  /// Matrix-free: the far-field sum runs directly below this many source–target pairs (in single
+  /// precision from fast_sum_tolerance 1e-4); above, the FMM decides by its cost model.
   double direct_sum_below = 4e6;
-  /// Matrix-free: the FMM's bound on the error of the far-field sum, relative per node to
-  /// Σ |S||g| over the Gauss points (stokeslet_sum.h); it sets the expansion order (fmm_sum.cc) [–].
+  /// Matrix-free: the bound on the error of the far-field sum, relative per node to Σ |S||g|
+  /// over the Gauss points (stokeslet_sum.h); it sets the FMM's expansion order (fmm_sum.cc) and
+  /// the direct sum's precision [–].
   double fast_sum_tolerance = 1e-4;
   /// Matrix-free: false uses the FMM whenever the geometry allows it, paying or not (tests).
   bool fast_sum_by_cost = true;
-  /// Matrix-free with the fast sum: the largest near radius (segment lengths) for the split,
-  /// which then takes max(tolerance, fast_sum_tolerance) as the quadrature's tolerance [–].
+  /// Matrix-free: the largest near radius (segment lengths) for the split, which takes
+  /// max(tolerance, fast_sum_tolerance) as the quadrature's tolerance [–].
   double fast_sum_near_delta = 12.0;
 };
 
