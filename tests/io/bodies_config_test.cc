@@ -72,9 +72,6 @@ TEST(BodiesConfig, BadBodiesAndWallsAreRefusedNamingTheKey) {
   ExpectError(std::string("[run]\nduration = 0.5\ntime_step = 0.01\nintegrator = \"bdf2\"\n") + kRod +
                   body + "motion = \"free\"\n",
               "run.integrator: \"bdf2\" does not take free bodies yet");
-  ExpectError("[[rods]]\nnodes = 21\naxis_length = 0.1\nhelix_radius = 0.008\nbody = 1\n" +
-                  std::string(kRun) + "[[bodies]]\nradius = 0.01\ncenter = [0.0, 0.0, 0.01]\nmotion = \"free\"\n",
-              "rods.1.body: rods on a \"free\" body are not implemented yet");
   ExpectError(base + "[wall]\nnormal = [0.0, 0.0, 0.0]\n", "case.toml: wall.normal: must not be the zero vector");
   ExpectError(base + "[wall]\nnormal = [0.0, 0.0, 1.0]\nside = 1\n", "wall.side: unknown key");
   ExpectError(base + "[fluid]\nmodel = \"rft\"\n[wall]\npoint = [0.0, 0.0, -1.0]\n",

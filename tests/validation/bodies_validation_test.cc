@@ -12,6 +12,7 @@
 #include <sstream>
 #include <string>
 
+#include "common/checkpoint_resume.h"
 #include "stokesrods/fluid/rigid_body.h"
 #include "stokesrods/io/build_bodies.h"
 #include "stokesrods/io/runner.h"
@@ -209,18 +210,8 @@ constexpr char kPass[] =
 
 // A checkpoint holds the drag of the bodies' points too: continuing from it is bit-identical.
 TEST(BodiesValidation, ACheckpointResumesBitIdentically) {
-  const std::string path = (std::filesystem::temp_directory_path() /
-                            ("stokesrods_bodies_checkpoint." + std::to_string(getpid()))).string();
-  Simulation a(ParseConfig(kPass, "pass.toml"));
-  for (int k = 0; k < 4; ++k) ASSERT_TRUE(a.Step().ok);
-  a.SaveCheckpoint(path);
-  Simulation b(ParseConfig(kPass, "pass.toml"));
-  b.LoadCheckpoint(path);
-  std::filesystem::remove(path);
-  for (int k = 0; k < 4; ++k) {
-    ASSERT_TRUE(a.Step().ok);
-    ASSERT_TRUE(b.Step().ok);
-  }
+  const ResumedPair p = RunAndResume(kPass, 4, 4);
+  const Simulation &a = *p.uninterrupted, &b = *p.resumed;
   EXPECT_EQ(a.state().q, b.state().q);
   EXPECT_EQ(a.workspace().hydro_force, b.workspace().hydro_force);
   EXPECT_EQ(Column(a, "body1_force_x"), Column(b, "body1_force_x"));

@@ -83,13 +83,6 @@ void ValidateBodiesAndWall(Config* config) {
       throw ConfigError(config->file, key,
                         fmt::format("body {} does not exist (there are {} [[bodies]])", rod.body,
                                     config->bodies.size()));
-    const BodyConfig& body = config->bodies[static_cast<std::size_t>(rod.body - 1)];
-    if (body.motion == "free")
-      throw ConfigError(config->file, key,
-                        fmt::format("rods on a \"{}\" body are not implemented yet (their clamp "
-                                    "would move with it, the motor turn against it); attach rods "
-                                    "to a \"fixed\" body",
-                                    body.motion));
     if (rod.clamped_nodes < 1)
       throw ConfigError(config->file, key, "a rod on a body needs clamped_nodes ≥ 1");
   }

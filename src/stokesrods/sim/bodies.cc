@@ -57,25 +57,46 @@ void AdvanceBodies(const Model& model, double h, const VecX& f, std::vector<Body
   }
 }
 
+namespace {
+
+// Moves rod's clamp (nodes and θ0) rigidly with its body from pose `from` to `to`.
+void MoveClamp(const RodModel& rod, const BodyPose& from, const BodyPose& to, VecX* q) {
+  const Mat3 turn = to.rotation * from.rotation.transpose();
+  if (turn == Mat3::Identity() && to.center == from.center) return;
+  const Vec3 t_old = (q->segment<3>(rod.dof_offset + NodeDof(1)) -
+                      q->segment<3>(rod.dof_offset + NodeDof(0))).normalized();
+  for (int i = 0; i < rod.clamped_nodes; ++i) {
+    auto x = q->segment<3>(rod.dof_offset + NodeDof(i));
+    x = to.center + turn * (Vec3(x) - from.center);
+  }
+  if (rod.clamped_nodes < 2) return;
+  const Vec3 t_new = turn * t_old, u = t_old.unitOrthogonal();
+  const Vec3 transported = ParallelTransport(u, t_old, t_new), turned = turn * u;
+  (*q)(rod.dof_offset + TwistDof(0)) +=
+      std::atan2(t_new.dot(transported.cross(turned)), transported.dot(turned));
+}
+
+}  // namespace
+
 void DriveBodyClamps(const Model& model, const std::vector<BodyPose>& from,
                      const std::vector<BodyPose>& to, VecX* q) {
+  for (const RodModel& rod : model.rods)
+    if (rod.body >= 0)
+      MoveClamp(rod, from[static_cast<std::size_t>(rod.body)],
+                to[static_cast<std::size_t>(rod.body)], q);
+}
+
+void PlaceFreeClamps(const Model& model, const VecX& start_q,
+                     const std::vector<BodyPose>& start_poses, double h, const VecX& f, VecX* q) {
+  std::vector<BodyPose> next = start_poses;
+  AdvanceBodies(model, h, f, &next);
   for (const RodModel& rod : model.rods) {
-    if (rod.body < 0) continue;
+    if (rod.body < 0 || model.bodies[static_cast<std::size_t>(rod.body)].motion != BodyMotion::kFree)
+      continue;
+    for (int k : rod.fixed_dofs) (*q)(rod.dof_offset + k) = start_q(rod.dof_offset + k);
+    if (rod.clamped_nodes >= 2) (*q)(rod.dof_offset + TwistDof(0)) += h * rod.twist_rate;
     const auto k = static_cast<std::size_t>(rod.body);
-    SR_ASSERT(model.bodies[k].motion != BodyMotion::kFree, "rods on free bodies are not built");
-    const Mat3 turn = to[k].rotation * from[k].rotation.transpose();
-    if (turn == Mat3::Identity() && to[k].center == from[k].center) continue;
-    const Vec3 t_old = (q->segment<3>(rod.dof_offset + NodeDof(1)) -
-                        q->segment<3>(rod.dof_offset + NodeDof(0))).normalized();
-    for (int i = 0; i < rod.clamped_nodes; ++i) {
-      auto x = q->segment<3>(rod.dof_offset + NodeDof(i));
-      x = to[k].center + turn * (Vec3(x) - from[k].center);
-    }
-    if (rod.clamped_nodes < 2) continue;
-    const Vec3 t_new = turn * t_old, u = t_old.unitOrthogonal();
-    const Vec3 transported = ParallelTransport(u, t_old, t_new), turned = turn * u;
-    (*q)(rod.dof_offset + TwistDof(0)) +=
-        std::atan2(t_new.dot(transported.cross(turned)), transported.dot(turned));
+    MoveClamp(rod, start_poses[k], next[k], q);
   }
 }
 

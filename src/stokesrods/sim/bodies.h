@@ -29,12 +29,18 @@ Vec6 BodyVelocity(const Model& model, int body, const VecX& f);
 /// The poses after a step of size h with the velocities of f.
 void AdvanceBodies(const Model& model, double h, const VecX& f, std::vector<BodyPose>* poses);
 
-/// Moves the clamps of rods on moving (prescribed) bodies from the poses `from` to `to`: the
-/// clamped nodes rigidly with the body, and θ0 by the body's spin about the first edge (the angle
-/// about the new tangent between the parallel transport of the old frame and its rigid rotation),
-/// on top of the motor's turn relative to the body (DriveBoundaryConditions).
+/// Moves the clamps of rods on moving bodies (prescribed, or free with a guess of V) from the
+/// poses `from` to `to`: the clamped nodes rigidly with the body, and θ0 by the body's spin about
+/// the first edge (the angle about the new tangent between the parallel transport of the old frame
+/// and its rigid rotation), on top of the motor's turn relative to the body (DriveBoundaryConditions).
 void DriveBodyClamps(const Model& model, const std::vector<BodyPose>& from,
                      const std::vector<BodyPose>& to, VecX* q);
+
+/// The clamps of rods on free bodies at the end of a step from `start_q` and `start_poses` with the
+/// bodies' V in f: Φ(V) of sim/clamp_border.h, as Step's DriveBoundaryConditions and
+/// DriveBodyClamps place them (the motor's turn, then the body's rigid motion).
+void PlaceFreeClamps(const Model& model, const VecX& start_q,
+                     const std::vector<BodyPose>& start_poses, double h, const VecX& f, VecX* q);
 
 /// Force and torque (about the centre) of the fluid on body k at `pose` from f [N, N·m].
 Vec6 BodyHydroLoad(const Model& model, int body, const BodyPose& pose, const VecX& f);

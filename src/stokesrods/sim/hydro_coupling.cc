@@ -146,11 +146,14 @@ void HydroCoupling::VelocityResidual(const Model& model, const VecX& q, const Ve
 }
 
 bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
-                                          std::vector<BandedMatrix>* jacobian) {
+                                          std::vector<BandedMatrix>* jacobian,
+                                          std::vector<ClampBorder>* borders) {
   SR_ASSERT(!explicit_, "the capacitance solve is for the implicit coupling");
   for (BandedMatrix& b : *jacobian)
     if (!b.Factorize()) return false;
   jacobian_ = jacobian;
+  borders_ = borders;
+  if (borders) CompleteClampBorders(model, *jacobian, borders);
   // The Krylov preconditioner (O((3M)³) for the full LU) is kept while it serves: rebuilt when
   // GMRES slowed, h changed, or it is kPreconditionerMaxAge steps old. B is always the new one.
   const bool rebuild = !krylov_ || !have_preconditioner_ || wants_refresh_ ||
@@ -176,6 +179,7 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
         const int first = 3 * model.rods[r].node_offset, n = static_cast<int>(sx_blocks_[r].rows());
         capacitance.block(first, first, n, n) += sx_blocks_[r];
       }
+      if (borders_) AddClampBordersToCapacitance(model, h, *borders_, &capacitance);
       if (krylov_) {
         if (!capacitance_lu_float_.Compute(capacitance.cast<float>()))
           return have_preconditioner_ = false;
@@ -204,6 +208,9 @@ void HydroCoupling::BuildSchurBlocks(const Model& model) {
     MatX& sx = sx_blocks_[r];
     sx.resize(3 * n, 3 * n);
     for (int i = 0; i < n; ++i) sx.middleRows<3>(3 * i) = x.middleRows<3>(NodeDof(i));
+    if (borders_)
+      for (ClampBorder& border : *borders_)
+        if (border.rod == static_cast<int>(r)) border.row_x = border.rows * x;
   }
 }
 
@@ -232,6 +239,7 @@ void HydroCoupling::ApplyCapacitance(const Model& model, double h, const VecX& v
   for (const RodModel& rod : model.rods)
     for (int i = 0; i < rod.num_nodes(); ++i)
       out->segment<3>(3 * (rod.node_offset + i)) += scratch_dofs_.segment<3>(rod.dof_offset + NodeDof(i));
+  if (borders_) ApplyClampBorders(model, h, *borders_, v, scratch_dofs_, out);
 }
 
 void HydroCoupling::BuildCoarseLevel(const Model& model, double h,
@@ -344,6 +352,7 @@ HydroSolveReport HydroCoupling::SolveNewtonSystem(const Model& model,
   for (const RodModel& rod : model.rods)  // S selects free DOFs only (X has zero fixed rows)
     for (int k : rod.fixed_dofs)
       if (k % 4 != 3) sy(3 * rod.node_offset + 3 * (k / 4) + k % 4) = 0.0;
+  if (borders_) AddClampBorderRhs(model, h, *borders_, *dq, &sy);
   const VecX b = -(h * r_u + sy);
   VecX cdf;  // C δf
   if (!krylov_) {
@@ -372,6 +381,7 @@ HydroSolveReport HydroCoupling::SolveNewtonSystem(const Model& model,
   // δq = y + X δf = y + B⁻¹ Sᵀ δf;  du = S δq/h + 𝕄 δf = (S y + C δf)/h.
   SolveBanded(model, *df, nullptr, &scratch_dofs_);
   *dq += scratch_dofs_;
+  if (borders_) AddClampMotion(model, h, *borders_, *df, dq);
   *du = (sy + cdf) / h;
   return report;
 }

@@ -30,6 +30,7 @@
 #include <Eigen/LU>
 
 #include "stokesrods/fluid/mobility_operator.h"
+#include "stokesrods/sim/clamp_border.h"
 #include "stokesrods/sim/forces.h"
 #include "stokesrods/sim/model.h"
 #include "stokesrods/sim/state.h"
@@ -54,7 +55,8 @@ class HydroCoupling {
   ///   r_u,body = 𝕄 f|_body + u_body = 0,   u_body = U + Ω × (x − c) known (fixed, prescribed);
   /// S has no rows there, so C = h𝕄 + S X extends by the bodies' rows and columns of h𝕄.
   /// Free bodies add 6 unknowns (U, Ω) each after the points, and 6 rows r_b = Gᵀ f (their
-  /// balance of force and torque) to r_u: the bordered mobility of fluid/rigid_body.h.
+  /// balance of force and torque) to r_u: the bordered mobility of fluid/rigid_body.h. Rods
+  /// clamped to a free body add their clamps' loads to r_b and border C (sim/clamp_border.h).
   void SetBodies(const Model& model, const std::vector<BodyPose>& poses);
 
   /// Takes 𝕄 at q_start; for the explicit coupling also solves for the drag of v_start.
@@ -73,7 +75,10 @@ class HydroCoupling {
   /// Builds X and the capacitance's factors (direct) or preconditioner (krylov) from the
   /// unfactorized banded parts B in `jacobian` (fixed DOFs identity rows; factorized in place).
   /// False if B or C is singular.
-  bool FactorizeNewtonSystem(const Model& model, double h, std::vector<BandedMatrix>* jacobian);
+  /// `borders`: the rods clamped to free bodies (sim/clamp_border.h), their Γ and K completed here
+  /// and kept (by pointer) for the solves until the next call.
+  bool FactorizeNewtonSystem(const Model& model, double h, std::vector<BandedMatrix>* jacobian,
+                             std::vector<ClampBorder>* borders = nullptr);
 
   /// Solves [B −Sᵀ; S/h 𝕄][δq; δf] = −[r_q; r_u] with the factors of FactorizeNewtonSystem, and
   /// gives du = S δq/h + 𝕄 δf, the change of r_u along (δq, δf). The Krylov solve stops at
@@ -105,6 +110,7 @@ class HydroCoupling {
   void BuildSchurBlocks(const Model& model);
   void SolveBanded(const Model& model, const VecX& nodal, const VecX* dofs, VecX* out) const;
   const std::vector<BandedMatrix>* jacobian_ = nullptr;  ///< the factorized B of the last rebuild
+  std::vector<ClampBorder>* borders_ = nullptr;  ///< of the last FactorizeNewtonSystem
   mutable VecX scratch_dofs_;
   void Precondition(const VecX& v, VecX* out) const;
 

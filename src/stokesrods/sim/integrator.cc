@@ -1,13 +1,13 @@
 #include "stokesrods/sim/integrator.h"
 
-#include "stokesrods/sim/bodies.h"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include <fmt/format.h>
 
+#include "stokesrods/sim/bodies.h"
+#include "stokesrods/sim/clamp_border.h"
 #include "stokesrods/sim/elastic_assembly.h"
 
 namespace stokesrods {
@@ -21,6 +21,7 @@ Workspace::Workspace(const Model& model) : local_forces(MakeLocalForces(model)) 
   if (nonlocal_fluid) {
     hydro.Init(model);
     hydro_force = hydro_force_try = VecX::Zero(model.hydro_size());
+    free_clamps = HasFreeClamps(model);
   }
 }
 
@@ -149,6 +150,16 @@ void Evaluate(const Model& model, const State& start, double h, const VecX& q,
                                                        h * start.velocity.segment(o, n)) / (h * h);
       if (jac) for (int k = 0; k < n; ++k) (*jac)[r](k, k) += rod.mass(k) / (h * h);
     }
+  }
+  // Clamps on free bodies: their reactions load the bodies, their rows and columns of B border
+  // the Newton system (sim/clamp_border.h); both before the clamped entries are fixed.
+  if (h > 0.0 && ws->free_clamps) {
+    if (jac) CaptureClampBorders(model, start.bodies, q, *jac, &ws->clamp_borders);
+    ClampLoads(model, start.bodies, q, *residual, &ws->clamp_loads);
+  }
+  for (std::size_t r = 0; r < model.rods.size(); ++r) {
+    const RodModel& rod = model.rods[r];
+    const int o = rod.dof_offset;
     for (int k : rod.fixed_dofs) {
       (*residual)(o + k) = 0.0;
       if (jac) (*jac)[r].FixDof(k);
@@ -165,7 +176,9 @@ bool UsesSaddle(const Model& model, double h, const Workspace& ws) {
 
 // Factorizes the Newton matrix assembled in ws->jacobian (in place).
 bool FactorizeJacobian(const Model& model, double h, Workspace* ws) {
-  if (UsesSaddle(model, h, *ws)) return ws->hydro.FactorizeNewtonSystem(model, h, &ws->jacobian);
+  if (UsesSaddle(model, h, *ws))
+    return ws->hydro.FactorizeNewtonSystem(model, h, &ws->jacobian,
+                                           ws->free_clamps ? &ws->clamp_borders : nullptr);
   for (BandedMatrix& b : ws->jacobian)
     if (!b.Factorize()) return false;
   return true;
@@ -218,8 +231,12 @@ NewtonReport SolveNewton(const Model& model, const State& start, double h, Works
                (saddle && ws->hydro.wants_refresh());
   Evaluate(model, start, h, ws->q, ws->hydro_force, fresh, ws, &ws->frames, &ws->residual);
   if (fresh) ws->factors_valid = false;  // ws->jacobian now holds an unfactorized assembly
-  if (saddle)
-    ws->hydro.VelocityResidual(model, ws->q, start.q, h, ws->hydro_force, &ws->velocity_residual);
+  // r_u; the free bodies' rows take the loads of their clamps (of the Evaluate just before).
+  auto no_slip_residual = [&](const VecX& q, const VecX& f, VecX* r_u) {
+    ws->hydro.VelocityResidual(model, q, start.q, h, f, r_u);
+    if (ws->free_clamps) r_u->tail(ws->clamp_loads.size()) -= ws->clamp_loads;
+  };
+  if (saddle) no_slip_residual(ws->q, ws->hydro_force, &ws->velocity_residual);
   auto norm_of = [&](const VecX& r, const VecX& r_u) {
     return saddle ? std::max(ResidualNorm(model, r), VelocityResidualNorm(model, r_u))
                   : ResidualNorm(model, r);
@@ -268,8 +285,14 @@ NewtonReport SolveNewton(const Model& model, const State& start, double h, Works
         ws->hydro_force_try = ws->hydro_force + alpha * ws->hydro_delta;
         ws->velocity_residual_try = ws->velocity_residual + alpha * ws->hydro_rate;
       }
+      // Clamps on free bodies: placed exactly by the trial's V (Φ, not its linearization); r_u
+      // is then evaluated, not extrapolated (the clamps' reactions are nonlinear in q).
+      if (saddle && ws->free_clamps)
+        PlaceFreeClamps(model, start.q, start.bodies, h, ws->hydro_force_try, &ws->q_try);
       Evaluate(model, start, h, ws->q_try, saddle ? ws->hydro_force_try : ws->hydro_force, false,
                ws, &ws->frames_try, &ws->residual_try);
+      if (saddle && ws->free_clamps)
+        no_slip_residual(ws->q_try, ws->hydro_force_try, &ws->velocity_residual_try);
       // A full step that already meets the tolerance is accepted without its simplified
       // correction (one linear solve less at the end of each step).
       if (alpha == 1.0 &&

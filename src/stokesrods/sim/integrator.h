@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "stokesrods/sim/clamp_border.h"
 #include "stokesrods/sim/contact_forces.h"
 #include "stokesrods/sim/forces.h"
 #include "stokesrods/sim/hydro_coupling.h"
@@ -53,6 +54,11 @@ struct Workspace {
   VecX hydro_force, hydro_force_try;
   VecX velocity_residual, velocity_residual_try;  ///< r_u at the iterate and at the trial
   VecX hydro_delta, hydro_rate, simplified_hydro_delta, simplified_hydro_rate;  ///< δf, du
+  /// Rods clamped to free bodies (sim/clamp_border.h): the border of the last Evaluate with the
+  /// Jacobian, and the clamps' loads G_cᵀ λ on the bodies (6 per free body) of the last Evaluate.
+  bool free_clamps = false;
+  std::vector<ClampBorder> clamp_borders;
+  VecX clamp_loads;
   VecX q;                        ///< the Newton iterate q(t_{k+1})
   VecX q_try;                    ///< line-search trial
   std::vector<RodFrames> frames; ///< frames transported to q
