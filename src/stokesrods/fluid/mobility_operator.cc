@@ -169,9 +169,10 @@ void MatrixFreeRssMobility::Update(const std::vector<HydroRod>& rods) {
   FindNearPairs(nodes_);
 }
 
-// Near pairs rod by rod: a rod whose bounding box, grown by the longest near reach, does not
-// hold the target has no near segment; otherwise every segment of the rod is tested at once
-// (vectorized over its segments). Near segments come out in rod order.
+// Near pairs by bounding boxes grown by the near reach: a rod's box, then its runs of
+// kChunkSegments consecutive segments (a long rod's box holds many targets that only a few of its
+// segments are near), then every segment of a run that passes at once (vectorized). Near segments
+// come out in rod order.
 void MatrixFreeRssMobility::FindNearPairs(const Matrix3X& targets) {
   const double delta2 = split_.near_delta * split_.near_delta;
   const int num_segments = static_cast<int>(segments_.size());
@@ -179,8 +180,24 @@ void MatrixFreeRssMobility::FindNearPairs(const Matrix3X& targets) {
   std::vector<double> ax(num_segments), ay(num_segments), az(num_segments), vx(num_segments),
       vy(num_segments), vz(num_segments), inv_v2(num_segments), e2(num_segments),
       reach2(num_segments);
-  std::vector<Eigen::AlignedBox3d> boxes(static_cast<size_t>(num_rods()));
-  std::vector<double> box_reach(static_cast<size_t>(num_rods()), 0.0);
+  // Boxes and reaches: rods first (index r), then chunks (num_rods() + chunk).
+  constexpr int kChunkSegments = 16;
+  std::vector<int> chunk_first_segment;  // per chunk; the rod's chunks are consecutive
+  std::vector<int> rod_first_chunk(static_cast<size_t>(num_rods()) + 1, 0);
+  for (int r = 0; r < num_rods(); ++r) {
+    rod_first_chunk[static_cast<size_t>(r)] = static_cast<int>(chunk_first_segment.size());
+    const int first = node_offset(r) - r, count = node_offset(r + 1) - node_offset(r) - 1;
+    for (int k = 0; k < count; k += kChunkSegments) chunk_first_segment.push_back(first + k);
+  }
+  rod_first_chunk.back() = static_cast<int>(chunk_first_segment.size());
+  chunk_first_segment.push_back(num_segments);
+  const std::size_t num_boxes = static_cast<size_t>(num_rods()) + chunk_first_segment.size() - 1;
+  std::vector<Eigen::AlignedBox3d> boxes(num_boxes);
+  std::vector<double> box_reach(num_boxes, 0.0);
+  std::vector<int> segment_chunk(static_cast<size_t>(num_segments));
+  for (std::size_t c = 0; c + 1 < chunk_first_segment.size(); ++c)
+    std::fill(segment_chunk.begin() + chunk_first_segment[c],
+              segment_chunk.begin() + chunk_first_segment[c + 1], static_cast<int>(c));
   for (int s = 0; s < num_segments; ++s) {
     const Segment& seg = segments_[static_cast<size_t>(s)];
     const Vec3 xa = nodes_.col(seg.a), v = nodes_.col(seg.a + 1) - xa;
@@ -188,10 +205,12 @@ void MatrixFreeRssMobility::FindNearPairs(const Matrix3X& targets) {
     inv_v2[s] = 1.0 / v.squaredNorm();
     e2[s] = seg.eps * seg.eps;
     reach2[s] = delta2 * v.squaredNorm();
-    boxes[static_cast<size_t>(seg.rod)].extend(xa);
-    boxes[static_cast<size_t>(seg.rod)].extend(Vec3(xa + v));
-    box_reach[static_cast<size_t>(seg.rod)] =
-        std::max(box_reach[static_cast<size_t>(seg.rod)], std::sqrt(reach2[s]));
+    for (const std::size_t b : {static_cast<size_t>(seg.rod),
+                                static_cast<size_t>(num_rods() + segment_chunk[static_cast<size_t>(s)])}) {
+      boxes[b].extend(xa);
+      boxes[b].extend(Vec3(xa + v));
+      box_reach[b] = std::max(box_reach[b], std::sqrt(reach2[s]));
+    }
   }
   // The exact near pairs minus the far sum's rule, by rows of RssRowKernel over the range of a
   // rod's segments that are near a target (vectorized; columns of segments in the range that
@@ -214,15 +233,20 @@ void MatrixFreeRssMobility::FindNearPairs(const Matrix3X& targets) {
     for (int t = 0; t < m; ++t) {
       const Vec3 p = targets.col(t);
       near.clear();
+      auto outside = [&](std::size_t b) { return boxes[b].exteriorDistance(p) >= box_reach[b]; };
       for (int r = 0; r < num_rods(); ++r) {
-        if (boxes[static_cast<size_t>(r)].exteriorDistance(p) >= box_reach[static_cast<size_t>(r)])
-          continue;
-        const int first = node_offset(r) - r, count = node_offset(r + 1) - node_offset(r) - 1;
-        flags.resize(static_cast<size_t>(count));
-        MarkNearSegments(p, first, count, ax.data(), ay.data(), az.data(), vx.data(), vy.data(),
-                         vz.data(), inv_v2.data(), e2.data(), reach2.data(), flags.data());
-        for (int k = 0; k < count; ++k)
-          if (flags[static_cast<size_t>(k)]) near.push_back(first + k);
+        if (outside(static_cast<size_t>(r))) continue;
+        for (int c = rod_first_chunk[static_cast<size_t>(r)];
+             c < rod_first_chunk[static_cast<size_t>(r) + 1]; ++c) {
+          if (outside(static_cast<size_t>(num_rods() + c))) continue;
+          const int first = chunk_first_segment[static_cast<size_t>(c)];
+          const int count = chunk_first_segment[static_cast<size_t>(c) + 1] - first;
+          flags.resize(static_cast<size_t>(count));
+          MarkNearSegments(p, first, count, ax.data(), ay.data(), az.data(), vx.data(), vy.data(),
+                           vz.data(), inv_v2.data(), e2.data(), reach2.data(), flags.data());
+          for (int k = 0; k < count; ++k)
+            if (flags[static_cast<size_t>(k)]) near.push_back(first + k);
+        }
       }
       std::vector<std::pair<int, Mat3>>& blocks = per_target[static_cast<size_t>(t)];
       for (std::size_t i = 0; i < near.size();) {  // one rod at a time (segments in rod order)
