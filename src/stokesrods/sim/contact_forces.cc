@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "stokesrods/contact/contact_response.h"
+#include "stokesrods/sim/obstacle_contact.h"
 #include "stokesrods/sim/state.h"
 
 namespace stokesrods {
@@ -120,10 +121,19 @@ VecX SolveMultipliers(const MatX& w, const VecX& eps) {
 }  // namespace
 
 ContactSummary AddContactForces(const Model& model, const VecX& q, double h,
-                                const LinearResponse& respond, VecX* contact_force) {
+                                const LinearResponse& respond, VecX* contact_force,
+                                const std::vector<BodyPose>& poses, VecX* body_loads) {
   const ContactInput in = MakeInput(model, q);
   const std::vector<ContactPair> pairs = DetectContacts(in.rods, in.radii, in.self_exclusion);
-  const ContactSummary summary = Summarize(model, pairs);
+  ContactSummary summary = Summarize(model, pairs);
+  const std::vector<ObstaclePair> obstacles =
+      poses.size() == model.bodies.size() ? DetectObstacleContacts(model, q, poses)
+                                          : std::vector<ObstaclePair>();
+  for (const ObstaclePair& o : obstacles) {
+    ++summary.detected;
+    summary.max_penetration = std::max(summary.max_penetration, o.penetration);
+    if (o.penetration > model.newton.contact_tolerance * model.rods[o.rod].radius) ++summary.active;
+  }
   if (summary.active == 0) return summary;
 
   // Clamped nodes have zero inverse mass: they never move, the other side takes it all.
@@ -138,24 +148,47 @@ ContactSummary AddContactForces(const Model& model, const VecX& q, double h,
     inverse_masses.push_back(std::move(w));
   }
   // Per pair: its eq. 19–20 force F_k and the response of every pair's separation to it.
-  const Eigen::Index p = static_cast<Eigen::Index>(pairs.size());
-  std::vector<VecX> forces(pairs.size(), VecX::Zero(model.num_dofs));
+  // The rods' pairs first, then the obstacles' (obstacle_contact.h: the node alone moves).
+  const Eigen::Index pr = static_cast<Eigen::Index>(pairs.size());
+  const Eigen::Index p = pr + static_cast<Eigen::Index>(obstacles.size());
+  std::vector<VecX> forces(static_cast<std::size_t>(p), VecX::Zero(model.num_dofs));
+  auto node_dof = [&](const ObstaclePair& o) { return model.rods[o.rod].dof_offset + NodeDof(o.node); };
   MatX w(p, p);
   VecX eps(p), dq;
   for (Eigen::Index k = 0; k < p; ++k) {
-    const std::vector<Matrix3X> dx = CalcContactDisplacements({pairs[k]}, inverse_masses);
-    for (std::size_t r = 0; r < model.rods.size(); ++r) {
-      const RodModel& rod = model.rods[r];
-      for (int i = 0; i < rod.num_nodes(); ++i)
-        forces[k].segment<3>(rod.dof_offset + NodeDof(i)) =
-            rod.mass(NodeDof(i)) * dx[r].col(i) / (h * h);
+    if (k < pr) {
+      const std::vector<Matrix3X> dx = CalcContactDisplacements({pairs[k]}, inverse_masses);
+      for (std::size_t r = 0; r < model.rods.size(); ++r) {
+        const RodModel& rod = model.rods[r];
+        for (int i = 0; i < rod.num_nodes(); ++i)
+          forces[k].segment<3>(rod.dof_offset + NodeDof(i)) =
+              rod.mass(NodeDof(i)) * dx[r].col(i) / (h * h);
+      }
+      eps(k) = pairs[k].penetration;
+    } else {
+      const ObstaclePair& o = obstacles[static_cast<std::size_t>(k - pr)];
+      forces[k].segment<3>(node_dof(o)) =
+          model.rods[o.rod].mass(NodeDof(o.node)) * o.penetration * o.normal / (h * h);
+      eps(k) = o.penetration;
     }
     respond(forces[k], &dq);
-    for (Eigen::Index j = 0; j < p; ++j) w(j, k) = SeparationChange(model, pairs[j], dq);
-    eps(k) = pairs[k].penetration;
+    for (Eigen::Index j = 0; j < p; ++j) {
+      if (j < pr) {
+        w(j, k) = SeparationChange(model, pairs[j], dq);
+      } else {
+        const ObstaclePair& o = obstacles[static_cast<std::size_t>(j - pr)];
+        w(j, k) = o.normal.dot(dq.segment<3>(node_dof(o)));
+      }
+    }
   }
   const VecX lambda = SolveMultipliers(w, eps);
-  for (Eigen::Index k = 0; k < p; ++k) *contact_force += lambda(k) * forces[k];
+  for (Eigen::Index k = 0; k < p; ++k) {
+    *contact_force += lambda(k) * forces[k];
+    if (k >= pr && body_loads) {
+      const ObstaclePair& o = obstacles[static_cast<std::size_t>(k - pr)];
+      AddObstacleReaction(model, o, lambda(k) * forces[k].segment<3>(node_dof(o)), poses, body_loads);
+    }
+  }
   return summary;
 }
 

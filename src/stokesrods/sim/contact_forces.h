@@ -9,8 +9,10 @@
 
 #include <functional>
 #include <limits>
+#include <vector>
 
 #include "stokesrods/sim/model.h"
+#include "stokesrods/sim/state.h"
 
 namespace stokesrods {
 
@@ -46,7 +48,11 @@ using LinearResponse = std::function<void(const VecX& force, VecX* dq)>;
 /// when the rod's stiffness or drag dominate, eq. 20 alone would close only a fraction
 /// m/(h² J) of the gap per round. Returns what it found before the correction (active = 0 means
 /// resolved).
+/// The rods' contacts with the wall and the bodies at `poses` (obstacle_contact.h) join the same
+/// multipliers; their reactions on free bodies accumulate in `body_loads` (6 per free body).
 ContactSummary AddContactForces(const Model& model, const VecX& q, double h,
-                                const LinearResponse& respond, VecX* contact_force);
+                                const LinearResponse& respond, VecX* contact_force,
+                                const std::vector<BodyPose>& poses = {},
+                                VecX* body_loads = nullptr);
 
 }  // namespace stokesrods

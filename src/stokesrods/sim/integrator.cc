@@ -235,6 +235,7 @@ NewtonReport SolveNewton(const Model& model, const State& start, double h, Works
   auto no_slip_residual = [&](const VecX& q, const VecX& f, VecX* r_u) {
     ws->hydro.VelocityResidual(model, q, start.q, h, f, r_u);
     if (ws->free_clamps) r_u->tail(ws->clamp_loads.size()) -= ws->clamp_loads;
+    if (model.num_free_bodies > 0) r_u->tail(ws->body_contact_load.size()) += ws->body_contact_load;
   };
   if (saddle) no_slip_residual(ws->q, ws->hydro_force, &ws->velocity_residual);
   auto norm_of = [&](const VecX& r, const VecX& r_u) {
@@ -338,6 +339,7 @@ void PrepareStep(const Model& model, const State& start, Workspace* ws) {
     if (model.coupling == FluidCoupling::kExplicit) ws->hydro_force = ws->hydro.explicit_force();
   }
   ws->contact_force.setZero();
+  ws->body_contact_load.setZero(6 * model.num_free_bodies);
   ws->load_factor = 1.0;
 }
 
@@ -425,7 +427,10 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
       VecX df, du;  // −J⁻¹(−F) = J⁻¹ F, the drag responding with the rods
       report.krylov_iterations += NewtonCorrection(model, he, -force, no_slip, ws, dq, &df, &du);
     };
-    report.contact = AddContactForces(model, ws->q, he, respond, &ws->contact_force);
+    std::vector<BodyPose> poses = state->bodies;  // at the step's end, with the current V
+    AdvanceBodies(model, h, ws->hydro_force, &poses);
+    report.contact = AddContactForces(model, ws->q, he, respond, &ws->contact_force, poses,
+                                      &ws->body_contact_load);
     if (report.contact.active == 0) break;  // report.contact describes the final state
     report.contact_pairs = std::max(report.contact_pairs, report.contact.detected);
     if (report.contact_rounds >= model.newton.max_contact_rounds) {
