@@ -8,6 +8,8 @@
 Measured per run, over the second half of the simulated time reached:
   U     the body's mean velocity along z, Δz/Δt [m/s] (and |Δc|/Δt, the speed along its path);
   Omega the body's mean angular velocity about z [rad/s], and over the motor's rate ω;
+  thrust the clamps' force on the rods along z, summed over the rods [N] (the fluid's force on the
+        body balances it);
   the bundle: the first time the rods' closest approach falls below 3 mm, the first output row with
   a contact, and the smallest approach (2 and 4 flagella). The paper's Δb (crossing) is not used:
   it is measured in the lab frame, in which the whole cell turns.
@@ -54,6 +56,8 @@ def measure(n, ts):
         "Omega_z": float(np.mean(ts["body1_omega_z"][half])),
     }
     out["Omega_over_omega"] = out["Omega_z"] / OMEGA
+    # The clamps' force on the rods, summed (the thrust the body takes), over the second half.
+    out["thrust"] = float(np.mean(sum(ts[f"rod{k}_force_z"] for k in range(1, n + 1))[half]))
     if n > 1:
         out["min_distance"] = float(np.min(ts["min_distance"]))
         out["t_below_3mm"] = first_time(t, ts["min_distance"] < 3e-3)
@@ -88,7 +92,7 @@ def plot():
     fig.tight_layout()
     os.makedirs(DOCS, exist_ok=True)
     fig.savefig(os.path.join(DOCS, "swimming_cell.png"), dpi=110)
-    keys = ["flagella", "t_end", "U_z", "speed", "Omega_z", "Omega_over_omega", "min_distance",
+    keys = ["flagella", "t_end", "U_z", "speed", "Omega_z", "Omega_over_omega", "thrust", "min_distance",
             "t_below_3mm", "t_contact"]
     with open(os.path.join(DOCS, "swimming_cell.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=keys)
