@@ -35,6 +35,7 @@
 
 #include "stokesrods/io/build_model.h"
 #include "stokesrods/io/config.h"
+#include "stokesrods/io/runner.h"
 #include "stokesrods/sim/integrator.h"
 #include "stokesrods/sim/state.h"
 
@@ -242,20 +243,28 @@ int RunCase(const Options& options, const CaseSpec& spec, nlohmann::ordered_json
 
   State state = MakeRestState(model);
   Workspace ws(model);
+  // As a run does (io/runner.h): the reuse across steps is forgotten at every restart point.
+  auto step = [&]() {
+    const StepReport r = Step(model, h, &state, &ws);
+    if (r.ok && state.step % kRestartSteps == 0) ForgetReuse(&ws);
+    return r;
+  };
   std::string failure;
   for (int k = 0; k < options.warmup && failure.empty(); ++k) {
     const auto start = std::chrono::steady_clock::now();
-    const StepReport r = Step(model, h, &state, &ws);
+    const StepReport r = step();
     if (!r.ok)
       failure = fmt::format("warm-up step {} (t = {:.6g} s): {}", k + 1, state.time, r.message);
     PrintProgress("warmup", k + 1, options.warmup, start);
   }
   std::vector<double> ms;
   long newton = 0, krylov = 0;
+  const MobilityReuseStats reuse_start =
+      ws.nonlocal_fluid ? ws.hydro.mobility().reuse_stats() : MobilityReuseStats{};
   const double cpu_start = ProcessCpuMs();
   for (int k = 0; k < options.steps && failure.empty(); ++k) {
     const auto start = std::chrono::steady_clock::now();
-    const StepReport r = Step(model, h, &state, &ws);
+    const StepReport r = step();
     const auto stop = std::chrono::steady_clock::now();
     if (!r.ok) {
       failure = fmt::format("timed step {} (t = {:.6g} s): {}", k + 1, state.time, r.message);
@@ -279,6 +288,12 @@ int RunCase(const Options& options, const CaseSpec& spec, nlohmann::ordered_json
   j["newton_per_step"] = Number(ms.empty() ? std::nan("") : static_cast<double>(newton) / n);
   j["krylov_per_step"] = Number(ms.empty() ? std::nan("") : static_cast<double>(krylov) / n);
   j["wall_s_per_sim_s"] = Number(mean * 1e-3 / h);
+  if (ws.nonlocal_fluid && ws.hydro.mobility().matrix() != nullptr) {  // the dense 𝕄's reuse
+    const MobilityReuseStats reuse = ws.hydro.mobility().reuse_stats();
+    j["assemblies_per_step"] =
+        Number(ms.empty() ? std::nan("") : static_cast<double>(reuse.assemblies - reuse_start.assemblies) / n);
+    j["reuse_largest_error"] = reuse.largest_error;
+  }
   j["ok"] = failure.empty();
   if (!failure.empty()) j["message"] = failure;
   return failure.empty() ? 0 : 3;

@@ -42,15 +42,21 @@ void MarkNearSegments(const Vec3& p, int first, int count, const double* ax, con
 
 class DenseMobility final : public MobilityOperator {
  public:
-  explicit DenseMobility(const FluidParams& params) : params_(params) {}
+  DenseMobility(const FluidParams& params, const MobilityOptions& options)
+      : params_(params), reuse_(options.reuse_tolerance) {}
 
   void Update(const std::vector<HydroRod>& rods) override {
     SetLayout(rods);
-    AssembleMobility(params_, rods, &matrix_);
+    VecX x(3 * node_offset(num_rods()));
+    for (int r = 0; r < num_rods(); ++r)
+      x.segment(3 * node_offset(r), 3 * rods[static_cast<size_t>(r)].x->cols()) =
+          rods[static_cast<size_t>(r)].x->reshaped();
+    reuse_.Update(x, [&](MatX* m) { AssembleMobility(params_, rods, m); }, &matrix_);
   }
   void UpdateWithBodies(const std::vector<HydroRod>& rods,
                         const std::vector<BodySurface>& bodies) override {
     if (bodies.empty()) return Update(rods);  // every fluid model
+    reuse_.Forget();  // bodies: assembled at every Update
     SetLayout(rods);
     for (const BodySurface& b : bodies) {
       num_body_points_ += static_cast<int>(b.points.cols());
@@ -58,6 +64,8 @@ class DenseMobility final : public MobilityOperator {
     }
     matrix_ = AssembleBorderedMobility(params_, rods, bodies);
   }
+  void ForgetHistory() override { reuse_.Forget(); }
+  MobilityReuseStats reuse_stats() const override { return reuse_.stats(); }
   void Apply(const VecX& force, VecX* velocity) const override {
     // Row blocks in parallel: the product streams the whole matrix (memory bound beyond cache).
     const Eigen::Index n = matrix_.rows();
@@ -77,6 +85,7 @@ class DenseMobility final : public MobilityOperator {
 
  private:
   FluidParams params_;
+  MobilityReuse reuse_;
   MatX matrix_;
 };
 
@@ -362,7 +371,7 @@ std::unique_ptr<MobilityOperator> MakeMobilityOperator(const FluidParams& params
                                                        const MobilityOptions& options) {
   if (options.kind == MobilityKind::kMatrixFree && params.model == FluidModel::kRss)
     return std::make_unique<MatrixFreeRssMobility>(params, options);
-  return std::make_unique<DenseMobility>(params);
+  return std::make_unique<DenseMobility>(params, options);
 }
 
 }  // namespace stokesrods

@@ -24,6 +24,7 @@
 
 #include "stokesrods/common/assert.h"
 #include "stokesrods/fluid/hydrodynamics.h"
+#include "stokesrods/fluid/mobility_reuse.h"
 #include "stokesrods/fluid/rigid_body.h"
 #include "stokesrods/fluid/stokeslet_sum.h"
 
@@ -49,6 +50,9 @@ struct MobilityOptions {
   /// Matrix-free: the largest near radius (segment lengths) for the split, which takes
   /// max(tolerance, fast_sum_tolerance) as the quadrature's tolerance [–].
   double fast_sum_near_delta = 12.0;
+  /// Dense: 𝕄 reused across Updates (time steps) by extrapolation while its measured relative
+  /// error stays below this (fluid/mobility_reuse.h); 0 assembles at every Update [–].
+  double reuse_tolerance = 0.0;
 };
 
 class MobilityOperator {
@@ -70,6 +74,11 @@ class MobilityOperator {
   virtual MatX SelfBlock(int rod) const = 0;
   /// The assembled 𝕄 when the operator holds one, else nullptr.
   virtual const MatX* matrix() const { return nullptr; }
+  /// Forgets what the operator keeps from earlier Updates (a restart point: the next Update
+  /// then depends on its geometry alone).
+  virtual void ForgetHistory() {}
+  /// Reuse of 𝕄 across Updates, counted since the operator was made.
+  virtual MobilityReuseStats reuse_stats() const { return {}; }
 
   int size() const { return 3 * (node_offset_.back() + num_body_points_) + 6 * num_free_bodies_; }
   int num_rods() const { return static_cast<int>(node_offset_.size()) - 1; }

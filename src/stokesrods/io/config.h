@@ -51,6 +51,7 @@ struct FluidConfig {
   std::string mobility = "auto";
   double far_field_tolerance = 1e-8;  ///< matrix-free: relative error of the far field [–]
   double fast_sum_tolerance = 1e-4;   ///< matrix-free: error bound of the FMM far-field sum [–]
+  double mobility_reuse_tolerance = 1e-4;  ///< dense: error of 𝕄 reused across steps [–]
   std::string solver = "krylov";      ///< implicit coupling: "krylov" (GMRES) | "direct" (dense LU)
   double krylov_tolerance = 1e-6;     ///< GMRES relative residual [–]
 };

@@ -30,6 +30,7 @@ void VisitFields(FluidConfig& c, V& v) {
   v("mobility", c.mobility);
   v("far_field_tolerance", c.far_field_tolerance);
   v("fast_sum_tolerance", c.fast_sum_tolerance);
+  v("mobility_reuse_tolerance", c.mobility_reuse_tolerance);
   v("solver", c.solver);
   v("krylov_tolerance", c.krylov_tolerance);
 }

@@ -132,6 +132,9 @@ void ValidateConfig(Config* config) {
   c.Positive("fluid.fast_sum_tolerance", config->fluid.fast_sum_tolerance);
   if (config->fluid.fast_sum_tolerance >= 1e-2)
     throw ConfigError(c.file, "fluid.fast_sum_tolerance", "must be below 1e-2");
+  c.NonNegative("fluid.mobility_reuse_tolerance", config->fluid.mobility_reuse_tolerance);
+  if (config->fluid.mobility_reuse_tolerance >= 1e-2)
+    throw ConfigError(c.file, "fluid.mobility_reuse_tolerance", "must be below 1e-2");
   if (config->fluid.krylov_tolerance >= 1e-2)
     throw ConfigError(c.file, "fluid.krylov_tolerance", "must be below 1e-2");
   c.Positive("contact.tolerance", config->contact.tolerance);

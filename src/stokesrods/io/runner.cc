@@ -74,6 +74,10 @@ class Observer {
     s["newton_iterations"] = result.newton_iterations;
     s["step_reductions"] = result.step_reductions;
     s["wall_seconds"] = result.wall_seconds;
+    if (model_.fluid.model == FluidModel::kRss || model_.fluid.model == FluidModel::kLsbt)
+      s["mobility_reuse"] = {{"updates", result.mobility_reuse.updates},
+                             {"assemblies", result.mobility_reuse.assemblies},
+                             {"largest_error", result.mobility_reuse.largest_error}};
     s["version"] = STOKESRODS_VERSION;
     WriteFileAtomically((fs::path(plan_.output_dir) / "summary.json").string(), s.dump(2) + "\n");
   }
@@ -266,6 +270,7 @@ RunResult RunCase(const Config& config, const RunOptions& options) {
   result.newton_iterations = counters.newton_iterations;
   result.step_reductions = counters.step_reductions;
   result.wall_seconds = wall();
+  if (ws.nonlocal_fluid) result.mobility_reuse = ws.hydro.mobility().reuse_stats();
   if (options.progress) options.progress({state.time, plan.duration, result.wall_seconds, state.step});
   observer.WriteSummary(result.status, result.message, result, counters.max_penetration);
   return result;

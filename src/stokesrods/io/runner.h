@@ -5,6 +5,8 @@
 #include <functional>
 #include <string>
 
+#include "stokesrods/fluid/mobility_reuse.h"
+
 #include "stokesrods/io/config.h"
 
 namespace stokesrods {
@@ -42,6 +44,9 @@ struct RunResult {
   long newton_iterations = 0;
   long step_reductions = 0;  ///< steps retried at h/2 (solver.max_step_halvings)
   double wall_seconds = 0.0;
+  /// The dense 𝕄's reuse across steps (fluid.mobility_reuse_tolerance), counted like
+  /// wall_seconds over this process's steps only (a resumed run counts from its restart).
+  MobilityReuseStats mobility_reuse;
 };
 
 /// Runs the configured case and writes its outputs. Throws ConfigError (bad input) and IoError

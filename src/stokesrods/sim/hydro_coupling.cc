@@ -129,6 +129,7 @@ void HydroCoupling::ForgetReuse(const VecX& drag_guess) {
   explicit_blocks_.reset();
   explicit_blocks_age_ = 0;
   explicit_force_ = drag_guess;
+  if (mobility_) mobility_->ForgetHistory();
 }
 
 void HydroCoupling::AddNodalForce(const Model& model, const VecX& f, VecX* force) {
