@@ -223,12 +223,13 @@ void MatrixFreeRssMobility::FindNearPairs(const Matrix3X& targets) {
   }
   // The exact near pairs minus the far sum's rule, by rows of RssRowKernel over the range of a
   // rod's segments that are near a target (vectorized; columns of segments in the range that
-  // are not near are left out).
+  // are not near are left out). "Exact" to the far field's own accuracy: no finer than the sum.
   std::vector<RssRowKernel> kernels;
   for (int r = 0; r < num_rods(); ++r)
     kernels.emplace_back(*rods_[static_cast<size_t>(r)].x,
                          params_.regularization * rods_[static_cast<size_t>(r)].radius,
-                         params_.far_field_tolerance, split_.gauss_points);
+                         std::max(params_.far_field_tolerance, options_.fast_sum_tolerance),
+                         split_.gauss_points);
   const double scale = 1.0 / (8.0 * kPi * params_.viscosity);
   const int m = static_cast<int>(targets.cols());
   std::vector<std::vector<std::pair<int, Mat3>>> per_target(static_cast<size_t>(m));
