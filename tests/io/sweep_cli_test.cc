@@ -181,7 +181,10 @@ TEST(SweepCli, UnderMpirunTheCasesAreSpreadOverTheRanks) {
   const fs::path dir = Dir("mpi");
   std::ofstream(dir / "s.toml") << "base = \"base.toml\"\noutput = \"" << (dir / "out").string()
                                 << "\"\n[vary]\n\"rods.omega_bar\" = [100, 200, 300, 400]\n";
-  const Outcome o = Shell(dir, std::string(STOKESRODS_MPIEXEC) +
+  // Under the asan preset: Open MPI 4.1 leaks its startup allocations in components it unloads
+  // before LeakSanitizer reports them (no library name left to suppress), so the ranks run
+  // without the leak check; the same sweep code runs with it in the tests above.
+  const Outcome o = Shell(dir, "ASAN_OPTIONS=detect_leaks=0 " + std::string(STOKESRODS_MPIEXEC) +
                                  " -n 2 --allow-run-as-root --oversubscribe " + Sweep(dir / "s.toml"));
   ASSERT_EQ(o.code, 0) << o.err;
   const auto rows = ReadCsv(dir / "out" / "sweep.csv");
