@@ -162,6 +162,39 @@ TEST(Cli, AFailedStepSaysWhenWhereAndWhatAndIsHalvedWhenAllowed) {
   EXPECT_EQ(times, (std::vector<std::string>{"time", "0", "0.25", "0.5", "0.75", "1"}));
 }
 
+TEST(Cli, AContactFailureSaysWhenWhereAndWhatAndSavesTheLastGoodState) {
+  // Rod 1's tip pushed into rod 2, 3 mm away, with one contact round allowed per step: the first
+  // step that brings the rods into contact cannot be resolved.
+  const fs::path cfg = WriteConfig(
+      "contact.toml", "[run]\nduration = 1.0\ntime_step = 0.01\n[fluid]\nmodel = \"none\"\n"
+                      "[contact]\nmax_rounds = 1\n[solver]\ndamping = 1.0\n"
+                      "[[rods]]\nshape = \"straight\"\nnodes = 21\n"
+                      "loads = [{node = 20, force = [1e-3, 0.0, 0.0]}]\n"
+                      "[[rods]]\nshape = \"straight\"\nnodes = 21\nbase = [0.003, 0.0, 0.0]\n");
+  const fs::path out = fs::temp_directory_path() / ("stokesrods_cli_contact." + std::to_string(getpid()));
+  fs::remove_all(out);
+  const Outcome o = RunCli("run " + cfg.string() + " --output " + out.string());
+  EXPECT_EQ(o.code, 3) << o.err;
+  for (const char* part : {"contact not resolved at t = ", "after 1 rounds", "the deepest rod 1, segment ",
+                           "against rod 2, segment ", "of the contact distance", "contact.max_rounds",
+                           "try a smaller run.time_step", "checkpoint.bin and the last frame"})
+    EXPECT_NE(o.err.find(part), std::string::npos) << part << "\n" << o.err;
+  const nlohmann::json summary = nlohmann::json::parse(Read(out / "summary.json"));
+  EXPECT_EQ(summary["status"], "failed");
+  // The last good state: the checkpoint resumes, the last frame is at the time before the failure.
+  ASSERT_TRUE(fs::exists(out / "checkpoint.bin"));
+  const double failed_at = std::stod(o.err.substr(o.err.find("at t = ") + 7));
+  const std::string pvd = Read(out / "rods.pvd");
+  const std::size_t last = pvd.rfind("timestep=\"");
+  ASSERT_NE(last, std::string::npos) << pvd;
+  EXPECT_NEAR(std::stod(pvd.substr(last + 10)), failed_at - 0.01, 1e-9) << pvd;
+  // With more rounds the same case runs through.
+  fs::remove_all(out);
+  const Outcome more = RunCli("run " + cfg.string() + " --output " + out.string() +
+                              " --set contact.max_rounds=50 --set run.duration=0.05");
+  EXPECT_EQ(more.code, 0) << more.err;
+}
+
 TEST(Cli, InterruptFlushesWritesACheckpointAndExits130) {
   const fs::path out = fs::temp_directory_path() / ("stokesrods_cli_interrupt." + std::to_string(getpid()));
   fs::remove_all(out);

@@ -4,11 +4,26 @@
 #include <cmath>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "stokesrods/contact/contact_response.h"
 #include "stokesrods/sim/obstacle_contact.h"
 #include "stokesrods/sim/state.h"
 
 namespace stokesrods {
+
+std::string DescribeDeepest(const ContactSummary& summary) {
+  auto segment = [](const SegmentId& s) {
+    return fmt::format("rod {}, segment {} (nodes {}-{})", s.rod + 1, s.index, s.index,
+                       s.index + 1);
+  };
+  if (summary.obstacle_node >= 0)
+    return fmt::format("rod {}, node {} against {}", summary.deepest.a.rod + 1,
+                       summary.obstacle_node,
+                       summary.obstacle_body < 0 ? std::string("the wall")
+                                                 : fmt::format("body {}", summary.obstacle_body + 1));
+  return segment(summary.deepest.a) + " against " + segment(summary.deepest.b);
+}
 
 int SelfContactExclusion(const RodModel& rod) {
   // Two segments of one rod that are fewer than this many edges apart cannot reach each other
@@ -41,6 +56,8 @@ ContactSummary Summarize(const Model& model, const std::vector<ContactPair>& pai
   ContactSummary summary;
   summary.detected = static_cast<int>(pairs.size());
   for (const ContactPair& pair : pairs) {
+    if (pair.penetration >= summary.max_penetration)
+      summary.deepest = pair.segments, summary.deepest_contact_distance = pair.contact_distance;
     summary.max_penetration = std::max(summary.max_penetration, pair.penetration);
     if (pair.penetration > model.newton.contact_tolerance * pair.contact_distance) ++summary.active;
   }
@@ -131,6 +148,12 @@ ContactSummary AddContactForces(const Model& model, const VecX& q, double h,
                                           : std::vector<ObstaclePair>();
   for (const ObstaclePair& o : obstacles) {
     ++summary.detected;
+    if (o.penetration >= summary.max_penetration) {
+      summary.deepest = SegmentPair{{o.rod, o.node}, {o.rod, o.node}};
+      summary.obstacle_node = o.node;
+      summary.obstacle_body = o.body;
+      summary.deepest_contact_distance = model.rods[o.rod].radius;
+    }
     summary.max_penetration = std::max(summary.max_penetration, o.penetration);
     if (o.penetration > model.newton.contact_tolerance * model.rods[o.rod].radius) ++summary.active;
   }

@@ -9,8 +9,10 @@
 
 #include <functional>
 #include <limits>
+#include <string>
 #include <vector>
 
+#include "stokesrods/contact/broad_phase.h"
 #include "stokesrods/sim/model.h"
 #include "stokesrods/sim/state.h"
 
@@ -22,7 +24,18 @@ struct ContactSummary {
   /// Smallest center-line distance between segments of different rods [m] (∞ for one rod).
   double min_distance = std::numeric_limits<double>::infinity();
   double max_penetration = 0.0;  ///< largest (r_a + r_b − distance) over all pairs, ≥ 0 [m]
+  /// Where that largest penetration is (meaningful when detected > 0): a segment pair (segment i
+  /// of a rod joins its nodes i and i + 1, 0-based), or, when obstacle_node ≥ 0, node
+  /// obstacle_node of rod deepest.a.rod against the wall (obstacle_body = −1) or a body.
+  SegmentPair deepest;
+  int obstacle_node = -1;
+  int obstacle_body = -1;
+  double deepest_contact_distance = 0.0;  ///< r_a + r_b, or r0 against an obstacle [m]
 };
+
+/// "rod 1, segment 14 (nodes 14-15) against rod 2, segment 9 (nodes 9-10)" or "rod 1, node 3
+/// against the wall" (rods and bodies from 1, nodes from 0).
+std::string DescribeDeepest(const ContactSummary& summary);
 
 /// Segments of one rod closer than this many indices apart are never in contact with each other.
 int SelfContactExclusion(const RodModel& rod);

@@ -120,6 +120,22 @@ std::string DescribeResidual(const Model& model, const VecX& r) {
                      twist ? "edge" : "node", worst_dof / 4, twist ? "a twist moment" : "a force");
 }
 
+// How the iterations went, when that points to a remedy: most of them damped by the line search
+// (the Newton matrix nearly singular: the step is close to an instability and too long for it),
+// and the last ones converging fast (more iterations would likely have finished the solve).
+std::string DescribeConvergence(const Model& model, const NewtonReport& newton) {
+  std::string text;
+  if (2 * newton.damped_iterations >= newton.iterations && newton.iterations > 0)
+    text += fmt::format("; {} of the {} iterations were damped by the line search (a nearly "
+                        "singular Newton matrix: the step is too long near an instability)",
+                        newton.damped_iterations, newton.iterations);
+  if (newton.last_reduction < 0.1 && std::isfinite(newton.residual))
+    text += fmt::format("; the last iteration reduced the residual {:.3g} times (still converging: "
+                        "a larger solver.newton_max_iterations than {} may finish it)",
+                        1.0 / newton.last_reduction, model.newton.max_iterations);
+  return text;
+}
+
 }  // namespace
 
 void Evaluate(const Model& model, const State& start, double h, const VecX& q,
@@ -316,7 +332,10 @@ NewtonReport SolveNewton(const Model& model, const State& start, double h, Works
       std::swap(ws->hydro_force, ws->hydro_force_try);
       std::swap(ws->velocity_residual, ws->velocity_residual_try);
     }
+    const double previous_norm = norm;
     norm = norm_of(ws->residual, ws->velocity_residual);
+    report.last_reduction = norm / previous_norm;
+    if (alpha < 1.0) ++report.damped_iterations;
     small_correction = simplified_norm <= step_tolerance;
     // Poor contraction (or a damped step): rebuild the factors at the new iterate. Otherwise the
     // simplified correction, made with the same factors at the accepted iterate, is the next one.
@@ -408,6 +427,7 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
           "the steps that fail",
           state->time + h, newton.residual, newton.tolerance, newton.iterations,
           DescribeResidual(model, ws->residual));
+      report.message += DescribeConvergence(model, newton);
       if (ws->nonlocal_fluid && !ws->hydro.worst_solve().ok)
         report.message += fmt::format(
             "; a GMRES solve of the drag stopped at a relative residual of {:.1e} after {} "
@@ -436,10 +456,12 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
     if (report.contact_rounds >= model.newton.max_contact_rounds) {
       report.message = fmt::format(
           "contact not resolved at t = {:.6g} s: {} pairs still closer than the contact distance "
-          "after {} rounds (largest penetration {:.3e} m); try a smaller run.time_step, a larger "
-          "contact.max_rounds, or solver.max_step_halvings",
+          "after {} rounds, the deepest {} (penetration {:.3e} m, {:.2g} of the contact "
+          "distance); try a smaller run.time_step, a larger contact.max_rounds, or "
+          "solver.max_step_halvings",
           state->time + h, report.contact.active, report.contact_rounds,
-          report.contact.max_penetration);
+          DescribeDeepest(report.contact), report.contact.max_penetration,
+          report.contact.max_penetration / report.contact.deepest_contact_distance);
       return report;
     }
   }

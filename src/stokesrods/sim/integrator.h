@@ -29,6 +29,8 @@ struct NewtonReport {
   double residual = 0.0;   ///< weighted ∞-norm of r at the last iterate [N]
   double tolerance = 0.0;  ///< what it had to reach [N]
   int krylov_iterations = 0;
+  int damped_iterations = 0;     ///< iterations whose step the line search shortened (α < 1)
+  double last_reduction = 1.0;   ///< residual after / before the last iteration
 };
 
 struct StepReport {
