@@ -145,9 +145,10 @@ dict of the same schema. Rods count from 1 (as in the output columns), nodes fro
       .def("set_loads", &SetLoads, py::arg("rod"), py::arg("loads"),
            "Replaces the rod's point loads by {node: [fx, fy, fz]} [N] from the next step on.")
       .def("save_checkpoint", &Simulation::SaveCheckpoint, py::arg("path"),
-           "Writes the state (not the controls set from Python) to a checkpoint file.")
+           "Writes the state and the controls (omega, point loads) to a checkpoint file.")
       .def("load_checkpoint", &Simulation::LoadCheckpoint, py::arg("path"),
-           "Replaces the state by a checkpoint's (written by save_checkpoint or a run).");
+           "Replaces the state and the controls (omega, point loads) by a checkpoint's (written by\n"
+           "save_checkpoint or a run).");
 }
 
 }  // namespace stokesrods::python

@@ -85,3 +85,33 @@ def test_checkpoint_round_trip(tmp_path, small):
     with pytest.raises(OSError, match="run.time_step"):
         stokesrods.Simulation(small, overrides={"run.time_step": 0.01}).load_checkpoint(
             str(tmp_path / "c.bin"))
+
+
+def test_checkpoint_keeps_the_controls_set_between_steps(tmp_path, small):
+    # A controller changed omega and the loads; a fresh Simulation of the same configuration that
+    # loads the checkpoint continues with those controls, digit for digit, not the configured ones.
+    force = [0.0, 2e-4, 0.0]
+    sim = stokesrods.Simulation(small)
+    sim.step(2)
+    sim.set_omega(1, 3.0)
+    sim.set_loads(2, {20: force, 7: [1e-4, 0.0, 0.0]})
+    sim.step(1)
+    sim.save_checkpoint(str(tmp_path / "c.bin"))
+    sim.step(3)
+    again = stokesrods.Simulation(small)
+    assert again.omega(1) != 3.0 and again.loads(2) == {}
+    again.load_checkpoint(str(tmp_path / "c.bin"))
+    assert again.omega(1) == 3.0 and again.omega(2) == sim.omega(2)
+    assert sorted(again.loads(2)) == [7, 20] and again.loads(1) == {}
+    np.testing.assert_array_equal(again.loads(2)[20], force)
+    again.step(3)
+    np.testing.assert_array_equal(again.positions(1), sim.positions(1))
+    np.testing.assert_array_equal(again.positions(2), sim.positions(2))
+    # Without the controls (as before checkpoint version 3) the continuation differs.
+    forgetful = stokesrods.Simulation(small)
+    forgetful.load_checkpoint(str(tmp_path / "c.bin"))
+    forgetful.set_omega(1, stokesrods.Simulation(small).omega(1))
+    forgetful.set_loads(2, {})
+    forgetful.step(3)
+    assert np.abs(forgetful.positions(2) - sim.positions(2)).max() > 1e-7
+

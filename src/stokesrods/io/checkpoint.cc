@@ -12,7 +12,8 @@ namespace stokesrods {
 namespace {
 
 constexpr char kMagic[8] = {'S', 'R', 'C', 'K', 'P', 'T', '\0', '\0'};
-constexpr std::uint32_t kVersion = 2;
+constexpr std::uint32_t kVersion = 3;
+constexpr std::uint32_t kOldestVersion = 2;  // without the controls
 
 std::uint64_t Fnv1a(const char* data, std::size_t bytes, std::uint64_t hash = 14695981039346656037ull) {
   for (std::size_t i = 0; i < bytes; ++i) {
@@ -26,7 +27,9 @@ class Writer {
  public:
   template <typename T>
   void Put(const T& value) { Raw(&value, sizeof value); }
-  void Raw(const void* data, std::size_t bytes) { out_.append(static_cast<const char*>(data), bytes); }
+  void Raw(const void* data, std::size_t bytes) {
+    if (bytes > 0) out_.append(static_cast<const char*>(data), bytes);
+  }
   void Vector(const VecX& v) {
     Put(static_cast<std::int64_t>(v.size()));
     Raw(v.data(), sizeof(double) * static_cast<std::size_t>(v.size()));
@@ -47,6 +50,7 @@ class Reader {
     return value;
   }
   void Raw(void* data, std::size_t bytes) {
+    if (bytes == 0) return;  // an empty vector's data() may be null: no memcpy (UBSan)
     if (bytes > text_.size() - at_) Fail("truncated");
     std::memcpy(data, text_.data() + at_, bytes);
     at_ += bytes;
@@ -70,6 +74,27 @@ class Reader {
   const std::string& text_;
   std::size_t at_ = 0;
 };
+
+// Each rod's rotation rate and point loads (version 3).
+std::vector<RodControls> ReadControls(const Model& model, Reader* r) {
+  std::vector<RodControls> controls(model.rods.size());
+  for (std::size_t i = 0; i < model.rods.size(); ++i) {
+    controls[i].omega = r->Get<double>();
+    const auto count = r->Get<std::int64_t>();
+    if (count < 0)
+      r->Fail(fmt::format("rod {} has {} point loads", i + 1, count));
+    for (std::int64_t k = 0; k < count; ++k) {
+      PointLoad load;
+      load.node = static_cast<int>(r->Get<std::int64_t>());
+      r->Raw(load.force.data(), 3 * sizeof(double));
+      if (load.node < 0 || load.node >= model.rods[i].num_nodes())
+        r->Fail(fmt::format("a point load on rod {} at node {}, which it does not have", i + 1,
+                            load.node));
+      controls[i].loads.push_back(load);
+    }
+  }
+  return controls;
+}
 
 }  // namespace
 
@@ -121,6 +146,14 @@ void SaveCheckpoint(const std::string& path, const Model& model, const Checkpoin
     w.Raw(pose.center.data(), 3 * sizeof(double));
     w.Raw(pose.rotation.data(), 9 * sizeof(double));
   }
+  for (const RodModel& rod : model.rods) {
+    w.Put(rod.omega);
+    w.Put(static_cast<std::int64_t>(rod.loads.size()));
+    for (const PointLoad& load : rod.loads) {
+      w.Put(static_cast<std::int64_t>(load.node));
+      w.Raw(load.force.data(), 3 * sizeof(double));
+    }
+  }
   w.Put(Fnv1a(w.text().data(), w.text().size()));
   WriteFileAtomically(path, w.text());
 }
@@ -134,8 +167,9 @@ Checkpoint LoadCheckpoint(const std::string& path, const Model& model) {
   if (text.size() < sizeof kMagic || (r.Raw(magic, sizeof magic), std::memcmp(magic, kMagic, sizeof kMagic) != 0))
     r.Fail("not a stokesrods checkpoint");
   const auto version = r.Get<std::uint32_t>();
-  if (version != kVersion)
-    r.Fail(fmt::format("format version {}, this stokesrods reads version {}", version, kVersion));
+  if (version < kOldestVersion || version > kVersion)
+    r.Fail(fmt::format("format version {}, this stokesrods reads versions {} to {}", version,
+                       kOldestVersion, kVersion));
   std::uint64_t stored_sum = 0;
   if (text.size() < sizeof stored_sum + r.at()) r.Fail("truncated");
   std::memcpy(&stored_sum, text.data() + text.size() - sizeof stored_sum, sizeof stored_sum);
@@ -174,6 +208,7 @@ Checkpoint LoadCheckpoint(const std::string& path, const Model& model) {
     r.Raw(pose.center.data(), 3 * sizeof(double));
     r.Raw(pose.rotation.data(), 9 * sizeof(double));
   }
+  if (version >= 3) c.controls = ReadControls(model, &r);
   if (r.at() + sizeof stored_sum != text.size()) r.Fail("unexpected data after the contents");
   return c;
 }

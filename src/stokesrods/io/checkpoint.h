@@ -6,13 +6,19 @@
 // the run forgets them at every restart point (sim/integrator.h ForgetReuse), so a resumed run,
 // which starts without them, rebuilds the same ones at the same step (docs/reliability.md).
 //
-// Format (little-endian, version 2): "SRCKPT\0\0", uint32 version, the payload, then the FNV-1a
+// Since version 3 it also holds the controls a caller may change between steps (each rod's
+// rotation rate and point loads; Simulation::SetOmega, SetLoads), which the model fingerprint
+// leaves out. A run from the command line takes them from its configuration; the Python
+// Simulation restores them. Version 2 files (no controls) still read.
+//
+// Format (little-endian, version 3): "SRCKPT\0\0", uint32 version, the payload, then the FNV-1a
 // 64-bit hash of everything before it. Written atomically (temporary file, then rename); a
 // damaged, truncated, foreign or other-version file is refused with an IoError naming it.
 #pragma once
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "stokesrods/sim/integrator.h"
 #include "stokesrods/sim/model.h"
@@ -27,11 +33,19 @@ struct RunCounters {
   long step_reductions = 0;      ///< steps retried at h/2
 };
 
+/// A rod's controls as they were when the checkpoint was written.
+struct RodControls {
+  double omega = 0.0;  ///< rotation rate about +ẑ [rad/s]
+  std::vector<PointLoad> loads;
+};
+
 struct Checkpoint {
   State state;
   StepHistory history;
   RunCounters counters;
   double time_step = 0.0;  ///< [s] the run's h (a resume must use the same)
+  /// Per rod; empty when read from a version 2 file. Saving writes the model's own controls.
+  std::vector<RodControls> controls;
 };
 
 /// A hash of what a checkpoint must match: the DOF layout, rest shapes, masses and stiffnesses.

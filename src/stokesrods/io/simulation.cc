@@ -44,6 +44,10 @@ void Simulation::LoadCheckpoint(const std::string& path) {
                               "{:.17g} s",
                               path, c.time_step, plan_.time_step));
   state_ = std::move(c.state);
+  for (std::size_t r = 0; r < c.controls.size(); ++r) {  // none from a version 2 file
+    SetRodOmega(&model_.rods[r], c.controls[r].omega);
+    model_.rods[r].loads = std::move(c.controls[r].loads);
+  }
   ForgetReuse(&ws_);
   RestoreHistory(c.history, &ws_);
 }

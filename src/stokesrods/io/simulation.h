@@ -41,8 +41,8 @@ class Simulation {
   /// Rod r (from 0): replaces its constant point loads, from the next step on.
   void SetLoads(int r, std::vector<PointLoad> loads);
 
-  /// The state and the step history (BDF2, the drag's first guess) to a checkpoint file, and back
-  /// (io/checkpoint.h; the controls set by SetOmega and SetLoads are not part of it). Continuing
+  /// The state, the step history (BDF2, the drag's first guess) and the controls set by SetOmega
+  /// and SetLoads to a checkpoint file, and back (io/checkpoint.h). Continuing
   /// after SaveCheckpoint and after LoadCheckpoint gives the same numbers. Throw IoError.
   void SaveCheckpoint(const std::string& path);
   void LoadCheckpoint(const std::string& path);
