@@ -19,7 +19,7 @@ import tempfile
 import numpy as np
 
 from .results import frame_index, read_frame, read_timeseries
-from .tubes import draw_rods, view_limits
+from .tubes import draw_rods, segment_values, view_limits
 
 VIEWS = [("front", 0, "x [cm]"), ("side", 1, "y [cm]")]  # (name, horizontal axis, label)
 
@@ -74,15 +74,22 @@ def views_figure(plt, frames, summary, color, field_range):
                 ax.set_ylabel("z [cm]")
             ax.set_title(f"{name}, t = {t:.3g} s\n$\\bar{{t}}$ = {t_bar(summary, t):.3g}", fontsize=9)
             ax.grid(alpha=0.25)
-    if mappable is not None:
-        fig.colorbar(mappable, ax=axes, shrink=0.5, label=f"|{color}| [N]")
+    add_colorbar(fig, mappable, axes, color)
     return fig
 
 
+def add_colorbar(fig, mappable, axes, color):
+    if mappable is not None:
+        fig.colorbar(mappable, ax=axes, shrink=0.5,
+                     label=f"|{color}| [N] (a segment: the mean of its two nodes)")
+
+
 def field_range(frames, color):
+    """(0, largest value a segment shows) over the frames (t, rods, data): the range of the colours
+    drawn (tubes.segment_values), so the top of the colour bar is a colour on the picture."""
     if color == "rod":
         return None
-    values = [np.linalg.norm(d[color], axis=1) for _, _, d in frames if color in d]
+    values = [np.concatenate(segment_values(r, d, color)) for _, r, d in frames if color in d]
     if not values:
         return None
     top = max(float(v.max()) for v in values)
@@ -123,7 +130,7 @@ def write_video(plt, run_dir, summary, index, color, fps, max_frames, out):
         for k, ((t, _), (rods, data)) in enumerate(zip(chosen, all_rods)):
             fig, axes = plt.subplots(1, 2, figsize=(8.0, 7.2), layout="constrained")
             for ax, (name, axis, label) in zip(axes, VIEWS):
-                draw_rods(ax, rods, radii(summary, rods), axis, data, color, frange)
+                mappable = draw_rods(ax, rods, radii(summary, rods), axis, data, color, frange)
                 ax.set_xlim(*limits[axis])
                 ax.set_ylim(*limits[2])
                 ax.set_aspect("equal")
@@ -132,6 +139,7 @@ def write_video(plt, run_dir, summary, index, color, fps, max_frames, out):
                 ax.set_ylabel("z [cm]")
                 ax.set_title(name)
                 ax.grid(alpha=0.25)
+            add_colorbar(fig, mappable, axes, color)
             fig.suptitle(f"t = {t:7.2f} s    $\\bar{{t}}$ = {t_bar(summary, t):.4f}")
             fig.savefig(os.path.join(tmp, f"f{k:05d}.png"), dpi=100)
             plt.close(fig)

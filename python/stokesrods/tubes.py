@@ -31,11 +31,24 @@ def _shade(rgb, f):
     return tuple(np.clip(np.asarray(rgb[:3]) * f, 0, 1))
 
 
+def segment_values(rods, data, color):
+    """Per rod, what each segment shows of the per-node field `color`: the mean of the magnitudes
+    at its two nodes (N − 1 values). The colour range spans these, not the node values."""
+    field = np.linalg.norm(data[color], axis=1)
+    values, start = [], 0
+    for x in rods:
+        node = field[start:start + len(x)]
+        values.append(0.5 * (node[:-1] + node[1:]))
+        start += len(x)
+    return values
+
+
 def draw_rods(ax, rods, radii, axis, data, color="rod", value_range=None):
     """Draws rods (list of N × 3 arrays [m]) seen along the horizontal axis other than `axis`
     (0: front view x-z seen from −y; 1: side view y-z seen from +x). color "rod" gives each rod
     its colour; a point-data name colours by the magnitude of that per-node field. Returns a
-    ScalarMappable for a colour bar (None for "rod")."""
+    ScalarMappable for a colour bar (None for "rod"). A segment shows the mean of its two nodes
+    (segment_values); value_range should span those."""
     import matplotlib
     from matplotlib.collections import PolyCollection
     nearness = (lambda x: -x[:, 1]) if axis == 0 else (lambda x: x[:, 0])
@@ -45,11 +58,10 @@ def draw_rods(ax, rods, radii, axis, data, color="rod", value_range=None):
         lo, hi = value_range or (0.0, 1.0)
         norm = matplotlib.colors.Normalize(lo, hi)
         mappable = matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap)
-        field = np.linalg.norm(data[color], axis=1)
+        shown = segment_values(rods, data, color)
     depth_all = np.concatenate([nearness(x) for x in rods])
     d_lo, d_span = depth_all.min(), max(np.ptp(depth_all), 1e-12)
     pieces = []  # (nearness, order, polygon, facecolor)
-    start = 0
     for k, (x, r) in enumerate(zip(rods, radii)):
         p = np.stack([x[:, axis], x[:, 2]], axis=1) * CM
         n = _normals(p) * r * CM
@@ -58,14 +70,13 @@ def draw_rods(ax, rods, radii, axis, data, color="rod", value_range=None):
         for i in range(len(x) - 1):
             d = 0.5 * (depth[i] + depth[i + 1])
             f = 0.55 + 0.45 * (d - d_lo) / d_span if d_span > 1e-12 else 1.0
-            rgb = base if color == "rod" else cmap(norm(0.5 * (field[start + i] + field[start + i + 1])))
+            rgb = base if color == "rod" else cmap(norm(shown[k][i]))
             body = [p[i] + n[i], p[i + 1] + n[i + 1], p[i + 1] - n[i + 1], p[i] - n[i]]
             stripe = [p[i] + 0.55 * n[i], p[i + 1] + 0.55 * n[i + 1], p[i + 1] + 0.2 * n[i + 1],
                       p[i] + 0.2 * n[i]]
             light = tuple(0.55 * np.asarray(_shade(rgb, f)) + 0.45)
             pieces.append((d, 2 * len(pieces), body, _shade(rgb, f)))
             pieces.append((d, 2 * len(pieces) + 1, stripe, light))
-        start += len(x)
     pieces.sort(key=lambda piece: (piece[0], piece[1]))
     ax.add_collection(PolyCollection([piece[2] for piece in pieces],
                                      facecolors=[piece[3] for piece in pieces],

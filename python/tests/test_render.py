@@ -61,3 +61,26 @@ def test_bad_run_directory(tmp_path):
     assert code == 2 and "not a directory" in err
     code, _ = run_cli("render")
     assert code == 2
+
+
+def test_colour_range_spans_what_the_segments_show():
+    # A field on one node only: its two segments show half of it (the mean of their two nodes),
+    # so the colour bar tops at half the node value and the brightest tube is the top colour.
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from stokesrods.render import field_range
+    from stokesrods.tubes import draw_rods, segment_values
+    rods = [np.column_stack([np.zeros(5), np.zeros(5), -0.01 * np.arange(5)]),
+            np.column_stack([0.02 + np.zeros(4), np.zeros(4), -0.01 * np.arange(4)])]
+    force = np.zeros((9, 3))
+    force[2] = [0.0, 3.0, 4.0]  # |f| = 5 at rod 1, node 2
+    data = {"contact_force": force}
+    shown = segment_values(rods, data, "contact_force")
+    np.testing.assert_array_equal(shown[0], [0.0, 2.5, 2.5, 0.0])
+    np.testing.assert_array_equal(shown[1], [0.0, 0.0, 0.0])
+    assert field_range([(0.0, rods, data)], "contact_force") == (0.0, 2.5)
+    fig, ax = plt.subplots()
+    mappable = draw_rods(ax, rods, [1e-3, 1e-3], 0, data, "contact_force", (0.0, 2.5))
+    assert mappable.norm(2.5) == 1.0
+    plt.close(fig)

@@ -8,7 +8,7 @@
 namespace stokesrods {
 
 std::string BodyFrameXml(const Model& model, const State& state, const VecX* body_forces,
-                         bool binary) {
+                         VtkFormat format) {
   const std::vector<BodySurface> surfaces = BodySurfaces(model, state.bodies);
   const VecX velocity = BodyPointVelocities(model, state.bodies);  // free bodies: 0
   const std::size_t p = static_cast<std::size_t>(model.num_body_points);
@@ -26,16 +26,16 @@ std::string BodyFrameXml(const Model& model, const State& state, const VecX* bod
       "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" "
       "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<PolyData>\n"
       "<Piece NumberOfPoints=\"{0}\" NumberOfVerts=\"{0}\">\n<Points>\n", p);
-  xml += VtkDataArray("points", points, 3, binary, 10) + "</Points>\n<Verts>\n";
-  xml += VtkDataArray("connectivity", connectivity, 1, binary);
-  xml += VtkDataArray("offsets", offsets, 1, binary) + "</Verts>\n";
-  xml += "<PointData>\n" + VtkDataArray("body", body_id, 1, binary);
-  xml += VtkDataArray("velocity", velocities, 3, binary, 8);
+  VtkArrays arrays(format);
+  xml += arrays.Add("points", points, 3, 10) + "</Points>\n<Verts>\n";
+  xml += arrays.Add("connectivity", connectivity, 1);
+  xml += arrays.Add("offsets", offsets, 1) + "</Verts>\n";
+  xml += "<PointData>\n" + arrays.Add("body", body_id, 1);
+  xml += arrays.Add("velocity", velocities, 3, 8);
   if (body_forces != nullptr && static_cast<std::size_t>(body_forces->size()) == 3 * p)
-    xml += VtkDataArray("hydrodynamic_force",
-                        std::vector<double>(body_forces->data(), body_forces->data() + 3 * p), 3,
-                        binary, 8);
-  return xml + "</PointData>\n</Piece>\n</PolyData>\n</VTKFile>\n";
+    xml += arrays.Add("hydrodynamic_force",
+                      std::vector<double>(body_forces->data(), body_forces->data() + 3 * p), 3, 8);
+  return xml + "</PointData>\n</Piece>\n</PolyData>\n" + arrays.AppendedData() + "</VTKFile>\n";
 }
 
 }  // namespace stokesrods

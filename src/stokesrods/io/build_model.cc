@@ -333,7 +333,9 @@ RunPlan MakeRunPlan(const Config& config, const Model& model) {
   plan.static_mode = config.run.mode == "static";
   plan.time_step = config.run.time_step;
   plan.frames = config.run.frames;
-  plan.binary_frames = config.run.frames_format == "binary";
+  plan.frames_format = config.run.frames_format == "binary"     ? VtkFormat::kBase64
+                       : config.run.frames_format == "appended" ? VtkFormat::kAppended
+                                                                : VtkFormat::kAscii;
   const Scales scales = CalcScales(model);
   plan.duration = config.run.duration ? *config.run.duration
                   : config.run.t_bar_end ? *config.run.t_bar_end * scales.time

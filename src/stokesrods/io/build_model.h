@@ -4,6 +4,7 @@
 #include <string>
 
 #include "stokesrods/io/config.h"
+#include "stokesrods/io/vtk_arrays.h"
 #include "stokesrods/sim/model.h"
 
 namespace stokesrods {
@@ -20,7 +21,7 @@ struct RunPlan {
   double checkpoint_wall_interval = 0.0;  ///< [s] of wall time (0: every checkpoint_interval)
   int max_step_halvings = 0;         ///< a failed step is retried as two of h/2, this deep
   bool frames = true;
-  bool binary_frames = false;        ///< run.frames_format = "binary"
+  VtkFormat frames_format = VtkFormat::kAscii;  ///< run.frames_format
   // The same in steps of time_step (dynamic runs).
   long total_steps = 0;
   long output_every = 1;

@@ -35,7 +35,7 @@ struct RunConfig {
   std::string integrator = "euler";       ///< "euler" (paper eq. 22) | "bdf2" (second order)
   std::optional<double> output_interval;  ///< [s], default: 1/100 of the run
   bool frames = true;
-  std::string frames_format = "ascii";    ///< "ascii" | "binary" (base64; large runs)
+  std::string frames_format = "ascii";    ///< "ascii" | "binary" (base64) | "appended" (raw)
   std::optional<double> checkpoint_interval;  ///< [s], default: 1/10 of the run
   /// [s] of wall time: if set, a checkpoint is written at the first restart point (every 20 steps
   /// and every checkpoint_interval) after this much wall time since the last one

@@ -24,7 +24,7 @@ const std::map<std::string, std::string>& Meanings() {
       {"run.integrator", "\"euler\" (implicit Euler, paper eq. 22, first order) or \"bdf2\" (second order; implicit coupling only)"},
       {"run.output_interval", "simulated seconds between rows of timeseries.csv and between frames (default 1/100 of the run)"},
       {"run.frames", "write ParaView frames (rods.pvd, frames/*.vtp)"},
-      {"run.frames_format", "\"ascii\" (readable, 10 digits) or \"binary\" (base64: exact doubles, faster to read, about the same size)"},
+      {"run.frames_format", "\"ascii\" (readable, 10 digits), \"binary\" (inline base64: exact doubles, about the ASCII's size) or \"appended\" (raw bytes at the end of each file: exact, the smallest and fastest to read)"},
       {"run.checkpoint_interval", "simulated seconds between checkpoints (default 1/10 of the run)"},
       {"run.checkpoint_wall_interval", "wall-clock seconds between checkpoints instead (written at the next restart point)"},
       {"fluid.model", "\"rss\" (regularized Stokeslet segments), \"lsbt\" (Lighthill slender-body theory), \"rft\" (resistive force theory, local) or \"none\""},

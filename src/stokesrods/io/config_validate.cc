@@ -94,7 +94,7 @@ void ValidateConfig(Config* config) {
   RunConfig& run = config->run;
   c.OneOf("run.mode", run.mode, {"dynamic", "static"});
   c.OneOf("run.integrator", run.integrator, {"euler", "bdf2"});
-  c.OneOf("run.frames_format", run.frames_format, {"ascii", "binary"});
+  c.OneOf("run.frames_format", run.frames_format, {"ascii", "binary", "appended"});
   if (run.integrator == "bdf2" && config->fluid.coupling == "explicit")
     throw ConfigError(c.file, "run.integrator",
                       "\"bdf2\" needs fluid.coupling = \"implicit\" (the explicit drag is first order)");

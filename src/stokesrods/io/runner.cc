@@ -34,7 +34,7 @@ class Observer {
       : config_(config), model_(model), plan_(plan), columns_(TimeseriesColumns(model)),
         csv_(PrepareCsv((fs::path(plan.output_dir) / "timeseries.csv").string(), kept_rows),
              columns_, kept_rows > 0) {
-    if (plan.frames) frames_.emplace(plan.output_dir, kept_rows, plan.binary_frames);
+    if (plan.frames) frames_.emplace(plan.output_dir, kept_rows, plan.frames_format);
   }
 
   void Record(const State& state, const Workspace& ws, const StepReport& report) {

@@ -5,20 +5,21 @@
 namespace stokesrods {
 namespace {
 
+// A UInt64 byte count followed by the values, little-endian (x86-64's own order).
 template <class T>
-std::string Binary(const std::vector<T>& values) {
+std::string CountedBytes(const std::vector<T>& values) {
   static_assert(sizeof(T) == 4 || sizeof(T) == 8);
   const std::uint64_t bytes = values.size() * sizeof(T);
-  std::string raw(reinterpret_cast<const char*>(&bytes), sizeof bytes);  // x86-64: little-endian
+  std::string raw(reinterpret_cast<const char*>(&bytes), sizeof bytes);
   raw.append(reinterpret_cast<const char*>(values.data()), bytes);
-  return Base64(raw);
+  return raw;
 }
 
-std::string Element(const std::string& name, const char* type, int components, bool binary,
-                    const std::string& body) {
+std::string Element(const std::string& name, const char* type, int components,
+                    const char* format, const std::string& body) {
   return fmt::format("<DataArray type=\"{}\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"{}\">\n{}\n"
                      "</DataArray>\n",
-                     type, name, components, binary ? "binary" : "ascii", body);
+                     type, name, components, format, body);
 }
 
 }  // namespace
@@ -39,24 +40,50 @@ std::string Base64(const std::string& bytes) {
   return out;
 }
 
-std::string VtkDataArray(const std::string& name, const std::vector<double>& values,
-                         int components, bool binary, int digits) {
-  if (binary) return Element(name, "Float64", components, true, Binary(values));
-  std::string body;
-  for (std::size_t i = 0; i < values.size(); ++i)
-    body += fmt::format("{:.{}g}{}", values[i], digits,
-                        (i + 1) % static_cast<std::size_t>(components) == 0 ? "\n" : " ");
-  if (!body.empty()) body.pop_back();
-  return Element(name, "Float64", components, false, body);
+template <class T>
+std::string VtkArrays::Encoded(const std::string& name, const char* type,
+                               const std::vector<T>& values, int components,
+                               const std::string& ascii_text) {
+  switch (format_) {
+    case VtkFormat::kAscii:
+      return Element(name, type, components, "ascii", ascii_text);
+    case VtkFormat::kBase64:
+      return Element(name, type, components, "binary", Base64(CountedBytes(values)));
+    case VtkFormat::kAppended:
+      break;
+  }
+  const std::size_t offset = appended_.size();
+  appended_ += CountedBytes(values);
+  return fmt::format("<DataArray type=\"{}\" Name=\"{}\" NumberOfComponents=\"{}\" "
+                     "format=\"appended\" offset=\"{}\"/>\n",
+                     type, name, components, offset);
 }
 
-std::string VtkDataArray(const std::string& name, const std::vector<std::int32_t>& values,
-                         int components, bool binary) {
-  if (binary) return Element(name, "Int32", components, true, Binary(values));
-  std::string body;
-  for (std::int32_t v : values) body += fmt::format("{} ", v);
-  if (!body.empty()) body.pop_back();
-  return Element(name, "Int32", components, false, body);
+std::string VtkArrays::Add(const std::string& name, const std::vector<double>& values,
+                           int components, int digits) {
+  std::string text;
+  if (format_ == VtkFormat::kAscii) {
+    for (std::size_t i = 0; i < values.size(); ++i)
+      text += fmt::format("{:.{}g}{}", values[i], digits,
+                          (i + 1) % static_cast<std::size_t>(components) == 0 ? "\n" : " ");
+    if (!text.empty()) text.pop_back();
+  }
+  return Encoded(name, "Float64", values, components, text);
+}
+
+std::string VtkArrays::Add(const std::string& name, const std::vector<std::int32_t>& values,
+                           int components) {
+  std::string text;
+  if (format_ == VtkFormat::kAscii) {
+    for (std::int32_t v : values) text += fmt::format("{} ", v);
+    if (!text.empty()) text.pop_back();
+  }
+  return Encoded(name, "Int32", values, components, text);
+}
+
+std::string VtkArrays::AppendedData() const {
+  if (format_ != VtkFormat::kAppended) return "";
+  return "<AppendedData encoding=\"raw\">\n_" + appended_ + "\n</AppendedData>\n";
 }
 
 }  // namespace stokesrods

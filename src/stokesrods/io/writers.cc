@@ -106,9 +106,9 @@ void TruncateCsv(const std::string& path, long rows) {
   WriteFileAtomically(path, text);
 }
 
-FrameWriter::FrameWriter(const std::string& output_dir, long keep, bool binary)
+FrameWriter::FrameWriter(const std::string& output_dir, long keep, VtkFormat format)
     : dir_(output_dir),
-      binary_(binary),
+      format_(format),
       keep_(keep),
       entries_(LeadingLines((fs::path(output_dir) / "rods.pvd").string(), "<DataSet ", keep)) {
   std::error_code ec;
@@ -144,18 +144,19 @@ void FrameWriter::Write(const Model& model, const State& state,
       "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<PolyData>\n"
       "<Piece NumberOfPoints=\"{}\" NumberOfLines=\"{}\">\n<Points>\n",
       m, model.rods.size());
-  xml += VtkDataArray("points", points, 3, binary_, 10) + "</Points>\n<Lines>\n";
-  xml += VtkDataArray("connectivity", connectivity, 1, binary_);
-  xml += VtkDataArray("offsets", offsets, 1, binary_) + "</Lines>\n";
-  xml += "<PointData Scalars=\"radius\">\n" + VtkDataArray("rod", rod_id, 1, binary_);
-  xml += VtkDataArray("radius", radius, 1, binary_, 10);
-  xml += VtkDataArray("material_d1", d1, 3, binary_, 8) + VtkDataArray("material_d2", d2, 3, binary_, 8);
+  VtkArrays arrays(format_);
+  xml += arrays.Add("points", points, 3, 10) + "</Points>\n<Lines>\n";
+  xml += arrays.Add("connectivity", connectivity, 1);
+  xml += arrays.Add("offsets", offsets, 1) + "</Lines>\n";
+  xml += "<PointData Scalars=\"radius\">\n" + arrays.Add("rod", rod_id, 1);
+  xml += arrays.Add("radius", radius, 1, 10);
+  xml += arrays.Add("material_d1", d1, 3, 8) + arrays.Add("material_d2", d2, 3, 8);
   for (const FramePointData& d : data) {
     if (d.values == nullptr || static_cast<std::size_t>(d.values->size()) != 3 * m) continue;
-    xml += VtkDataArray(d.name, std::vector<double>(d.values->data(), d.values->data() + 3 * m), 3,
-                        binary_, 8);
+    xml += arrays.Add(d.name, std::vector<double>(d.values->data(), d.values->data() + 3 * m), 3,
+                      8);
   }
-  xml += "</PointData>\n</Piece>\n</PolyData>\n</VTKFile>\n";
+  xml += "</PointData>\n</Piece>\n</PolyData>\n" + arrays.AppendedData() + "</VTKFile>\n";
   WriteFileAtomically((fs::path(dir_) / name).string(), xml);
   AddToIndex(dir_, "rods.pvd", state.time, name, &entries_);
   if (model.bodies.empty()) return;
@@ -164,7 +165,7 @@ void FrameWriter::Write(const Model& model, const State& state,
   body_entries_read_ = true;
   const std::string body_name = fmt::format("frames/bodies_{:05d}.vtp", body_entries_.size());
   WriteFileAtomically((fs::path(dir_) / body_name).string(),
-                      BodyFrameXml(model, state, body_forces, binary_));
+                      BodyFrameXml(model, state, body_forces, format_));
   AddToIndex(dir_, "bodies.pvd", state.time, body_name, &body_entries_);
 }
 

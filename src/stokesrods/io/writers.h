@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "stokesrods/io/vtk_arrays.h"
 #include "stokesrods/sim/model.h"
 #include "stokesrods/sim/state.h"
 
@@ -45,8 +46,9 @@ class FrameWriter {
  public:
   /// `keep`: frames of an earlier run kept (--resume): the first `keep` entries of its rods.pvd,
   /// which must have them; the next frame is number `keep`.
-  /// `binary`: base64 arrays (exact doubles, faster to read; about the size of the ASCII).
-  explicit FrameWriter(const std::string& output_dir, long keep = 0, bool binary = false);
+  /// `format`: ASCII (10 digits), base64 or appended raw arrays (io/vtk_arrays.h; both exact).
+  explicit FrameWriter(const std::string& output_dir, long keep = 0,
+                       VtkFormat format = VtkFormat::kAscii);
   /// With bodies, also frames/bodies_NNNNN.vtp (their surface points as vertices, with `body`,
   /// `velocity` and, given `body_forces` (3P), `hydrodynamic_force`) and the bodies.pvd index.
   void Write(const Model& model, const State& state, const std::vector<FramePointData>& data,
@@ -54,7 +56,7 @@ class FrameWriter {
 
  private:
   std::string dir_;
-  bool binary_ = false;
+  VtkFormat format_ = VtkFormat::kAscii;
   long keep_ = 0;
   std::vector<std::string> entries_;  ///< the DataSet lines of rods.pvd
   std::vector<std::string> body_entries_;  ///< of bodies.pvd (read on the first body frame)
@@ -63,7 +65,7 @@ class FrameWriter {
 
 /// The bodies' surface points at the state's time as a VTK PolyData file (vertices).
 std::string BodyFrameXml(const Model& model, const State& state, const VecX* body_forces,
-                         bool binary);
+                         VtkFormat format);
 
 /// Keeps the header and the first `rows` rows of an existing CSV file (--resume); IoError if it
 /// has fewer.
