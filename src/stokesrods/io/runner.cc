@@ -199,7 +199,7 @@ RunResult RunCase(const Config& config, const RunOptions& options) {
   const Schedule schedule{plan};
   long saved_step = -1;
   auto save_checkpoint = [&] {
-    SaveCheckpoint(checkpoint, model, {state, CaptureHistory(ws), counters, h});
+    SaveCheckpoint(checkpoint, model, {state, CaptureHistory(ws), counters, h, {}});
     saved_step = state.step;
   };
   if (kept_rows == 0) {

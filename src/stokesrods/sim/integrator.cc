@@ -129,7 +129,7 @@ std::string DescribeConvergence(const Model& model, const NewtonReport& newton) 
     text += fmt::format("; {} of the {} iterations were damped by the line search (a nearly "
                         "singular Newton matrix: the step is too long near an instability)",
                         newton.damped_iterations, newton.iterations);
-  if (newton.last_reduction < 0.1 && std::isfinite(newton.residual))
+  if (newton.last_reduction < 0.5 && std::isfinite(newton.residual))
     text += fmt::format("; the last iteration reduced the residual {:.3g} times (still converging: "
                         "a larger solver.newton_max_iterations than {} may finish it)",
                         1.0 / newton.last_reduction, model.newton.max_iterations);
