@@ -22,20 +22,14 @@ std::string BodyFrameXml(const Model& model, const State& state, const VecX* bod
       offsets.push_back(static_cast<std::int32_t>(body_id.size() + 1));
       body_id.push_back(static_cast<std::int32_t>(k + 1));
     }
-  std::string xml = fmt::format(
-      "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" "
-      "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<PolyData>\n"
-      "<Piece NumberOfPoints=\"{0}\" NumberOfVerts=\"{0}\">\n<Points>\n", p);
   VtkArrays arrays(format);
-  xml += arrays.Add("points", points, 3, 10) + "</Points>\n<Verts>\n";
-  xml += arrays.Add("connectivity", connectivity, 1);
-  xml += arrays.Add("offsets", offsets, 1) + "</Verts>\n";
-  xml += "<PointData>\n" + arrays.Add("body", body_id, 1);
+  std::string xml = PolyDataStart(&arrays, points, "Verts", connectivity, offsets);
+  xml += arrays.Add("body", body_id, 1);
   xml += arrays.Add("velocity", velocities, 3, 8);
   if (body_forces != nullptr && static_cast<std::size_t>(body_forces->size()) == 3 * p)
     xml += arrays.Add("hydrodynamic_force",
                       std::vector<double>(body_forces->data(), body_forces->data() + 3 * p), 3, 8);
-  return xml + "</PointData>\n</Piece>\n</PolyData>\n" + arrays.AppendedData() + "</VTKFile>\n";
+  return xml + PolyDataEnd(arrays);
 }
 
 }  // namespace stokesrods

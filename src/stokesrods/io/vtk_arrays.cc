@@ -81,6 +81,25 @@ std::string VtkArrays::Add(const std::string& name, const std::vector<std::int32
   return Encoded(name, "Int32", values, components, text);
 }
 
+std::string PolyDataStart(VtkArrays* arrays, const std::vector<double>& points, const char* cells,
+                          const std::vector<std::int32_t>& connectivity,
+                          const std::vector<std::int32_t>& offsets,
+                          const std::string& point_data_attributes) {
+  std::string xml = fmt::format(
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" "
+      "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<PolyData>\n"
+      "<Piece NumberOfPoints=\"{}\" NumberOf{}=\"{}\">\n<Points>\n",
+      points.size() / 3, cells, offsets.size());
+  xml += arrays->Add("points", points, 3, 10) + fmt::format("</Points>\n<{}>\n", cells);
+  xml += arrays->Add("connectivity", connectivity, 1);
+  xml += arrays->Add("offsets", offsets, 1) + fmt::format("</{}>\n", cells);
+  return xml + "<PointData" + point_data_attributes + ">\n";
+}
+
+std::string PolyDataEnd(const VtkArrays& arrays) {
+  return "</PointData>\n</Piece>\n</PolyData>\n" + arrays.AppendedData() + "</VTKFile>\n";
+}
+
 std::string VtkArrays::AppendedData() const {
   if (format_ != VtkFormat::kAppended) return "";
   return "<AppendedData encoding=\"raw\">\n_" + appended_ + "\n</AppendedData>\n";

@@ -37,6 +37,16 @@ class VtkArrays {
   std::string appended_;  ///< the raw block after '_' (appended)
 };
 
+/// A VTK XML PolyData file up to the opening of its <PointData> element (`point_data_attributes`
+/// inside its tag, e.g. ` Scalars="radius"`): the header, the points (3 per point) and the cells
+/// of kind `cells` ("Lines" or "Verts") given by their connectivity and offsets.
+std::string PolyDataStart(VtkArrays* arrays, const std::vector<double>& points, const char* cells,
+                          const std::vector<std::int32_t>& connectivity,
+                          const std::vector<std::int32_t>& offsets,
+                          const std::string& point_data_attributes = "");
+/// Closes what PolyDataStart opened, with the appended data block if any.
+std::string PolyDataEnd(const VtkArrays& arrays);
+
 /// RFC 4648 base64 of `bytes`.
 std::string Base64(const std::string& bytes);
 

@@ -139,16 +139,10 @@ void FrameWriter::Write(const Model& model, const State& state,
     }
     offsets.push_back(rod.node_offset + rod.num_nodes());
   }
-  std::string xml = fmt::format(
-      "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" "
-      "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<PolyData>\n"
-      "<Piece NumberOfPoints=\"{}\" NumberOfLines=\"{}\">\n<Points>\n",
-      m, model.rods.size());
   VtkArrays arrays(format_);
-  xml += arrays.Add("points", points, 3, 10) + "</Points>\n<Lines>\n";
-  xml += arrays.Add("connectivity", connectivity, 1);
-  xml += arrays.Add("offsets", offsets, 1) + "</Lines>\n";
-  xml += "<PointData Scalars=\"radius\">\n" + arrays.Add("rod", rod_id, 1);
+  std::string xml =
+      PolyDataStart(&arrays, points, "Lines", connectivity, offsets, " Scalars=\"radius\"");
+  xml += arrays.Add("rod", rod_id, 1);
   xml += arrays.Add("radius", radius, 1, 10);
   xml += arrays.Add("material_d1", d1, 3, 8) + arrays.Add("material_d2", d2, 3, 8);
   for (const FramePointData& d : data) {
@@ -156,7 +150,7 @@ void FrameWriter::Write(const Model& model, const State& state,
     xml += arrays.Add(d.name, std::vector<double>(d.values->data(), d.values->data() + 3 * m), 3,
                       8);
   }
-  xml += "</PointData>\n</Piece>\n</PolyData>\n" + arrays.AppendedData() + "</VTKFile>\n";
+  xml += PolyDataEnd(arrays);
   WriteFileAtomically((fs::path(dir_) / name).string(), xml);
   AddToIndex(dir_, "rods.pvd", state.time, name, &entries_);
   if (model.bodies.empty()) return;
