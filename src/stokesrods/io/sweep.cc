@@ -10,6 +10,7 @@
 #include <toml++/toml.h>
 
 #include "stokesrods/io/config.h"
+#include "stokesrods/io/config_compare.h"
 #include "stokesrods/io/writers.h"
 
 namespace stokesrods {
@@ -334,7 +335,7 @@ CaseRecord ReadCaseRecord(const Sweep& sweep, const SweepCase& c) {
   std::vector<std::string> overrides = c.overrides;
   overrides.push_back(OutputOverride(c.output_dir));
   const nlohmann::json now = nlohmann::json::parse(ConfigToJson(LoadConfig(sweep.base, overrides)));
-  if (summary["config"] != now) return pending;  // made from another configuration: rerun
+  if (!SameRunSettings(summary["config"], now)) return pending;  // another configuration: rerun
   const std::string status = summary.value("status", "");
   const int code = status == "completed" ? 0 : status == "failed" ? 3 : 130;
   CaseRecord r = MakeCaseRecord(code, 0, summary.value("wall_seconds", 0.0), summary.dump());

@@ -91,7 +91,8 @@ struct CaseRecord {
 };
 
 /// The case's state from its folder: "completed" or "failed" when its summary.json says so and
-/// was made from the same resolved configuration as the case now; "interrupted" (resumable) when
+/// was made from the configuration the case has now (SameRunSettings, io/config_compare.h: keys
+/// added to the program since the run count when at their defaults); "interrupted" (resumable) when
 /// it has a checkpoint and a summary saying so; otherwise "pending" (never run, crashed, or run
 /// from a different configuration).
 CaseRecord ReadCaseRecord(const Sweep& sweep, const SweepCase& c);
