@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "stokesrods/io/writers.h"
+#include "stokesrods/sim/observables.h"
 
 namespace stokesrods {
 
@@ -83,7 +84,7 @@ RunAnalysis AnalyzeRun(const std::string& run_dir) {
   for (std::size_t i = 0; i < n; ++i)
     if (t_bar[i] >= 0.8 * a.t_bar_end)
       a.max_tip_axis_distance_over_r = std::max(a.max_tip_axis_distance_over_r, tip[i] / helix_radius);
-  a.buckled = a.max_tip_axis_distance_over_r > 2.0;
+  a.buckled = a.max_tip_axis_distance_over_r > kBuckledTipAxisDistanceOverR;
   a.final_length_bar = Column(ts, "rod1_length_bar", ts_path).back();
   const std::vector<double>& fp = Column(ts, "propulsive_force_bar", ts_path);
   double sum = 0.0;

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "stokesrods/fluid/lsbt.h"
+#include "stokesrods/sim/observables.h"
 #include "stokesrods/fluid/rft.h"
 #include "stokesrods/rod/geometry.h"
 #include "stokesrods/sim/hydro_coupling.h"
@@ -348,6 +349,8 @@ RunPlan MakeRunPlan(const Config& config, const Model& model) {
                                  : std::max(plan.time_step, plan.duration / 10.0);
   plan.checkpoint_wall_interval = config.run.checkpoint_wall_interval.value_or(0.0);
   plan.max_step_halvings = config.solver.max_step_halvings;
+  if (config.run.stop_when_buckled)
+    plan.stop_tip_axis_distance = kBuckledTipAxisDistanceOverR * config.rods[0].helix_radius;
   if (!plan.static_mode) SetStepCounts(config, &plan);
   return plan;
 }

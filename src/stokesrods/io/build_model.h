@@ -20,6 +20,9 @@ struct RunPlan {
   double checkpoint_interval = 0.0;  ///< [s]
   double checkpoint_wall_interval = 0.0;  ///< [s] of wall time (0: every checkpoint_interval)
   int max_step_halvings = 0;         ///< a failed step is retried as two of h/2, this deep
+  /// > 0 (run.stop_when_buckled): stop once rod 1's last node is farther than this from the
+  /// vertical through its clamp [m]
+  double stop_tip_axis_distance = 0.0;
   bool frames = true;
   VtkFormat frames_format = VtkFormat::kAscii;  ///< run.frames_format
   // The same in steps of time_step (dynamic runs).

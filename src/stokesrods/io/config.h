@@ -40,6 +40,10 @@ struct RunConfig {
   /// [s] of wall time: if set, a checkpoint is written at the first restart point (every 20 steps
   /// and every checkpoint_interval) after this much wall time since the last one
   std::optional<double> checkpoint_wall_interval;
+  /// Stop at the first output row where rod 1 has buckled by analyze's rule (io/analysis.h: its
+  /// last node farther than 2R from its clamp's vertical); status "completed". Saves the costly
+  /// post-buckling motion (self-contact) in buckling-threshold sweeps.
+  bool stop_when_buckled = false;
 };
 
 struct FluidConfig {

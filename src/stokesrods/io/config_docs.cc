@@ -27,6 +27,7 @@ const std::map<std::string, std::string>& Meanings() {
       {"run.frames_format", "\"ascii\" (readable, 10 digits), \"binary\" (inline base64: exact doubles, about the ASCII's size) or \"appended\" (raw bytes at the end of each file: exact, the smallest and fastest to read)"},
       {"run.checkpoint_interval", "simulated seconds between checkpoints (default 1/10 of the run)"},
       {"run.checkpoint_wall_interval", "wall-clock seconds between checkpoints instead (written at the next restart point)"},
+      {"run.stop_when_buckled", "stop (status completed) at the first output row where rod 1 has buckled by `analyze`'s rule: its last node farther than 2R from the vertical through its clamp (rod 1 a helix; dynamic runs)"},
       {"fluid.model", "\"rss\" (regularized Stokeslet segments), \"lsbt\" (Lighthill slender-body theory), \"rft\" (resistive force theory, local) or \"none\""},
       {"fluid.viscosity", "μ [Pa·s]"},
       {"fluid.regularization", "RSS blob size ε in units of the rod radius r0"},

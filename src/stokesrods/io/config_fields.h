@@ -20,6 +20,7 @@ void VisitFields(RunConfig& c, V& v) {
   v("frames_format", c.frames_format);
   v("checkpoint_interval", c.checkpoint_interval);
   v("checkpoint_wall_interval", c.checkpoint_wall_interval);
+  v("stop_when_buckled", c.stop_when_buckled);
 }
 template <class V>
 void VisitFields(FluidConfig& c, V& v) {

@@ -112,6 +112,10 @@ void ValidateConfig(Config* config) {
   if (run.checkpoint_interval) c.Positive("run.checkpoint_interval", *run.checkpoint_interval);
   if (run.checkpoint_wall_interval)
     c.Positive("run.checkpoint_wall_interval", *run.checkpoint_wall_interval);
+  if (run.stop_when_buckled && (run.mode != "dynamic" || config->rods.empty() ||
+                                config->rods[0].shape != "helix"))
+    throw ConfigError(c.file, "run.stop_when_buckled",
+                      "needs a dynamic run whose rod 1 is a helix (the rule measures its helix radius)");
 
   c.OneOf("fluid.model", config->fluid.model, {"rss", "lsbt", "rft", "none"});
   c.OneOf("fluid.coupling", config->fluid.coupling, {"implicit", "explicit"});

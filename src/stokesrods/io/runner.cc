@@ -43,6 +43,13 @@ class Observer {
     WriteFrame(state, ws);
   }
 
+  /// The last row's value of `column` (NaN if there is no such column or no row yet).
+  double LastValue(const std::string& column) const {
+    for (std::size_t i = 0; i < columns_.size() && i < last_row_.size(); ++i)
+      if (columns_[i] == column) return last_row_[i];
+    return std::nan("");
+  }
+
   void WriteFrame(const State& state, const Workspace& ws) {
     if (frames_) {
       // The rods' nodes' drag (the bodies' points follow them in ws.hydro_force).
@@ -247,7 +254,18 @@ RunResult RunCase(const Config& config, const RunOptions& options) {
       break;
     }
     counters.max_penetration = std::max(counters.max_penetration, report.contact.max_penetration);
-    if (schedule.Records(state.step)) observer.Record(state, ws, report);
+    if (schedule.Records(state.step)) {
+      observer.Record(state, ws, report);
+      const double tip = observer.LastValue("rod1_tip_axis_distance");
+      if (plan.stop_tip_axis_distance > 0.0 && tip > plan.stop_tip_axis_distance) {
+        result.message = fmt::format(
+            "stopped at t_bar = {:.6g}: rod 1 buckled (its last node {:.3g} R off its clamp's vertical)",
+            observer.LastValue("t_bar"),
+            kBuckledTipAxisDistanceOverR * tip / plan.stop_tip_axis_distance);
+        save_checkpoint();
+        break;
+      }
+    }
     write_flow();
     if (schedule.IsRestartPoint(state.step)) {
       ForgetReuse(&ws);

@@ -23,6 +23,11 @@ Scales CalcScales(const Model& model);
 /// max_penetration (this step), newton_iterations (this step).
 std::vector<std::string> TimeseriesColumns(const Model& model);
 
+/// A helix has buckled when its tip is off its clamp's vertical by more than this × its helix
+/// radius R (a helical rod keeps it at R; its axis tilts when it buckles): analyze's rule
+/// (io/analysis.h) and run.stop_when_buckled.
+constexpr double kBuckledTipAxisDistanceOverR = 2.0;
+
 /// One row for the state after `report` (ws holds the forces of that step).
 std::vector<double> CalcTimeseriesRow(const Model& model, const State& state, const Workspace& ws,
                                       const StepReport& report);
