@@ -93,9 +93,8 @@ int AnalyzeSweep(const AnalyzeOptions& options) {
   WriteFileAtomically((fs::path(options.dir) / "analysis.csv").string(), csv);
 
   std::string critical = "line,below,above,estimate,monotone,points\n";
-  fmt::print("{} along {} ({}: {}):\n", criterion == "crossed" ? "critical crossing" : "critical buckling",
-             line, criterion, criterion == "crossed" ? "delta_b <= 0 at the end of the run"
-                                                     : "tip > 2R off the clamp's vertical in the last 20 %");
+  fmt::print("{} along {} ({}: {}):\n", criterion == "buckled" ? "critical buckling" : "critical crossing",
+             line, criterion, CriterionRule(criterion));
   for (const LineResult& l : CriticalAlongLines(sweep, line, outcomes)) {
     std::string fixed, points;
     for (const auto& [k, v] : l.fixed) fixed += (fixed.empty() ? "" : " ") + k + "=" + v;

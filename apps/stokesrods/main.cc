@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "stokesrods/io/analysis.h"
 #include "stokesrods/io/build_model.h"
 #include "stokesrods/io/config.h"
 #include "stokesrods/io/runner.h"
@@ -94,8 +95,8 @@ int main(int argc, char** argv) {
       "analyze", "derived results of a run or a sweep: crossing time, critical speeds, F̄p");
   analyze->add_option("dir", analyze_options.dir, "a run's or a sweep's output folder")->required();
   analyze->add_option("--line", analyze_options.line, "sweep key along which to find the critical value");
-  analyze->add_option("--criterion", analyze_options.criterion, "crossed | buckled")
-      ->check(CLI::IsMember({"crossed", "buckled"}));
+  analyze->add_option("--criterion", analyze_options.criterion, "crossed | ever_crossed | buckled")
+      ->check(CLI::IsMember(stokesrods::OutcomeCriteria()));
   analyze->add_option("--single", analyze_options.single,
                       "a run or sweep of one flagellum: F̄p relative to it at the same omega_bar");
 

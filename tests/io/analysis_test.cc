@@ -43,6 +43,9 @@ TEST(Analysis, CrossingTimeIsInterpolatedAndTheFinalSignDecides) {
   EXPECT_DOUBLE_EQ(ra.omega_bar, 213.0);
   EXPECT_FALSE(ra.buckled);
   EXPECT_EQ(Outcome(ra, "crossed"), std::optional<bool>(false));
+  EXPECT_EQ(Outcome(ra, "ever_crossed"), std::optional<bool>(true));  // crossed at t̄ = 1.5
+  const fs::path never = RunDir("never", header + "0,1,0.01,0,0.04,4,0.03\n1,1,0.01,1,0.001,0.1,0.02\n");
+  EXPECT_EQ(Outcome(AnalyzeRun(never.string()), "ever_crossed"), std::optional<bool>(false));
 }
 
 TEST(Analysis, BuckledWhenTheTipLeavesTwoRadiiInTheLastFifth) {
@@ -51,6 +54,7 @@ TEST(Analysis, BuckledWhenTheTipLeavesTwoRadiiInTheLastFifth) {
   const RunAnalysis early = AnalyzeRun(RunDir("b", header + "0,1,0.01,0\n0.5,1,0.05,0\n1,1,0.01,0\n").string());
   EXPECT_FALSE(early.buckled);
   EXPECT_FALSE(early.crossed.has_value());  // one rod
+  EXPECT_FALSE(Outcome(early, "ever_crossed").has_value());
   const RunAnalysis late = AnalyzeRun(RunDir("c", header + "0,1,0.01,0\n0.5,1,0.01,0\n1,1,0.021,0\n").string());
   EXPECT_TRUE(late.buckled);
   EXPECT_DOUBLE_EQ(late.max_tip_axis_distance_over_r, 2.1);

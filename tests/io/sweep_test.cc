@@ -99,6 +99,10 @@ TEST(Sweep, BadFilesNameTheKeyAndTheProblem) {
   EXPECT_NE(ErrorOf("[vary]\n\"rods.3.omega_bar\" = [1]\n").find("rod 3 does not exist"), std::string::npos);
   EXPECT_NE(ErrorOf("[vary]\n\"rods.nodes\" = [1]\n").find("case nodes=1"), std::string::npos);
   EXPECT_NE(ErrorOf("[vary]\n\"rods.omega_bar\" = [1, 1]\n").find("duplicate case"), std::string::npos);
+  const std::string refine = "[vary]\n\"rods.omega_bar\" = [1, 2]\n[refine]\nkey = \"rods.omega_bar\"\n"
+                             "resolution = 0.5\ncriterion = ";
+  EXPECT_NE(ErrorOf(refine + "\"fast\"\n").find("\"ever_crossed\""), std::string::npos);
+  EXPECT_EQ(Parse(refine + "\"ever_crossed\"\n").refine->criterion, "ever_crossed");
   try {
     ParseSweep("base = \"missing.toml\"\noutput = \"x\"\n", "s.toml", Dir().string());
     FAIL();

@@ -98,8 +98,21 @@ RunAnalysis AnalyzeRun(const std::string& run_dir) {
 
 std::optional<bool> Outcome(const RunAnalysis& a, const std::string& criterion) {
   if (criterion == "crossed") return a.crossed;
+  if (criterion == "ever_crossed")
+    return a.crossed ? std::optional<bool>(a.first_crossing_t_bar.has_value()) : std::nullopt;
   if (criterion == "buckled") return a.buckled;
   return std::nullopt;
+}
+
+const std::vector<std::string>& OutcomeCriteria() {
+  static const std::vector<std::string> kCriteria = {"crossed", "ever_crossed", "buckled"};
+  return kCriteria;
+}
+
+std::string CriterionRule(const std::string& criterion) {
+  if (criterion == "crossed") return "delta_b <= 0 at the end of the run";
+  if (criterion == "ever_crossed") return "delta_b <= 0 at some output row";
+  return "tip > 2R off the clamp's vertical in the last 20 %";
 }
 
 std::vector<LineResult> CriticalAlongLines(const Sweep& sweep, const std::string& key,

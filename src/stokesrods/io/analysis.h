@@ -5,6 +5,8 @@
 // Rules (docs/validation.md states them next to the results):
 //  - crossed: Δb ≤ 0 at the end of the run (paper Fig. 7c3 marks the final shape); the first
 //    crossing time is the first t̄ at which Δb ≤ 0, linearly interpolated between output rows.
+//  - ever_crossed: Δb ≤ 0 at some output row (a first crossing time exists): a tight bundle's tips
+//    can turn back to Δb > 0 at the end after crossing (paper Fig. 9 at large pitch).
 //  - buckled: rod 1's last node farther than 2R from the vertical through its clamp at some output
 //    row of the last 20 % of the run (a helical rod keeps it at R; its axis tilts when it buckles).
 //  - F̄p: propulsive_force_bar averaged over the second half of the run (time average of the output
@@ -41,8 +43,13 @@ struct RunAnalysis {
 /// The analysis of one run folder. Throws IoError when its files are missing.
 RunAnalysis AnalyzeRun(const std::string& run_dir);
 
-/// A yes/no outcome per case along a line: "crossed" or "buckled".
+/// A yes/no outcome per case along a line: "crossed", "ever_crossed" or "buckled" (none: the
+/// criterion does not apply, e.g. crossing with one rod).
 std::optional<bool> Outcome(const RunAnalysis& a, const std::string& criterion);
+
+/// The criteria Outcome knows, and each one's rule in words (for messages and tables).
+const std::vector<std::string>& OutcomeCriteria();
+std::string CriterionRule(const std::string& criterion);
 
 /// The critical value of `key` on one line of a sweep (the other varied keys fixed): the outcome
 /// switches from no (below) to yes (at and above) between `below` and `above`.

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include "stokesrods/io/analysis.h"
 #include "stokesrods/io/config.h"
 #include "stokesrods/io/config_compare.h"
 #include "stokesrods/io/writers.h"
@@ -124,8 +125,9 @@ std::optional<RefineSpec> ReadRefine(const toml::table& root, const Sweep& sweep
   if (std::find(sweep.varied_keys.begin(), sweep.varied_keys.end(), spec.key) == sweep.varied_keys.end())
     throw ConfigError(file, "refine.key", "expected one of the varied keys");
   spec.criterion = t["criterion"].value_or(std::string());
-  if (spec.criterion != "crossed" && spec.criterion != "buckled")
-    throw ConfigError(file, "refine.criterion", "expected \"crossed\" or \"buckled\"");
+  const std::vector<std::string>& criteria = OutcomeCriteria();
+  if (std::find(criteria.begin(), criteria.end(), spec.criterion) == criteria.end())
+    throw ConfigError(file, "refine.criterion", "expected \"crossed\", \"ever_crossed\" or \"buckled\"");
   spec.resolution = t["resolution"].value_or(0.0);
   if (!(spec.resolution > 0.0)) throw ConfigError(file, "refine.resolution", "expected a number > 0");
   return spec;

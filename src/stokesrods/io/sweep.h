@@ -36,8 +36,8 @@ struct SweepCase {
   std::string output_dir;              ///< <sweep output>/<name>
 };
 
-/// [refine]: bisect `key` between the cases where `criterion` ("crossed" | "buckled", see
-/// io/analysis.h) switches from no to yes, until the bracket is at most `resolution` wide.
+/// [refine]: bisect `key` between the cases where `criterion` ("crossed" | "ever_crossed" |
+/// "buckled", see io/analysis.h) switches from no to yes, until the bracket is at most `resolution` wide.
 struct RefineSpec {
   std::string key;
   std::string criterion;
