@@ -108,6 +108,22 @@ def switch_bracket(points):
     return below, above, not any(yes for _, yes in points[:first_yes])
 
 
+def bracket_errorbar(ax, rows, column, below_key, above_key, **style):
+    """Critical brackets (below, above] along x = row[column], drawn at their middles with the
+    bracket as the error bar; at `above`, as an upper bound, where there is no `below`."""
+    xs, ys, lo, hi = [], [], [], []
+    for r in rows:
+        if not r[above_key]:
+            continue
+        above = float(r[above_key])
+        below = float(r[below_key]) if r[below_key] else 0.0
+        xs.append(float(r[column]))
+        ys.append(0.5 * (below + above) if r[below_key] else above)
+        lo.append(ys[-1] - below)
+        hi.append(above - ys[-1])
+    ax.errorbar(xs, ys, yerr=[lo, hi], capsize=3, **style)
+
+
 def crossing_marker(ax, x, y, crossed):
     """One case of a crossing diagram: ● crossed (Δb ≤ 0 at the end), △ not."""
     ax.plot(x, y, "o" if crossed else "^", ms=5, mfc="tab:blue" if crossed else "none",

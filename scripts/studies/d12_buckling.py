@@ -13,7 +13,7 @@ drawn at its middle with the bracket as an error bar.
 """
 import os
 
-from common import ROOT, case_table, read_csv, sweep_study_main, write_csv
+from common import ROOT, bracket_errorbar, case_table, read_csv, sweep_study_main, write_csv
 
 SWEEP = "examples/studies/d12_buckling.toml"
 OUT = os.path.join(ROOT, "out", "studies", "d12")
@@ -75,17 +75,8 @@ def plot():
                 buckled = r["buckled"] == "1"
                 ax.plot(float(r[column]), float(r["omega_bar"]), "o" if buckled else "^", ms=5,
                         mfc="tab:red" if buckled else "none", mec="tab:red" if buckled else "tab:blue")
-        xs, ys, lo, hi = [], [], [], []
-        for r in read_csv(CRITICAL):
-            if r["study"] != study or not r["omega_b_above"]:
-                continue
-            above = float(r["omega_b_above"])
-            below = float(r["omega_b_below"]) if r["omega_b_below"] else 0.0
-            xs.append(float(r[column]))
-            ys.append(0.5 * (below + above) if r["omega_b_below"] else above)
-            lo.append(ys[-1] - below)
-            hi.append(above - ys[-1])
-        ax.errorbar(xs, ys, yerr=[lo, hi], fmt="k-", capsize=3, label="ω̄_b (bracket)")
+        rows = [r for r in read_csv(CRITICAL) if r["study"] == study]
+        bracket_errorbar(ax, rows, column, "omega_b_below", "omega_b_above", fmt="k-", label="ω̄_b (bracket)")
         ax.set_xlabel(label)
         ax.set_ylabel("ω̄")
         ax.set_yscale("log")

@@ -15,7 +15,7 @@ table also gives the bracket of "crossed at some t̄ ≤ 2" (a first crossing ti
 """
 import os
 
-from common import (ROOT, case_table, crossing_marker, finish_crossing_axes, read_csv, sweep_study_main,
+from common import (ROOT, bracket_errorbar, case_table, crossing_marker, finish_crossing_axes, read_csv, sweep_study_main,
                     switch_bracket, write_csv)
 
 SWEEP = "examples/studies/fig9_pitch_radius.toml"
@@ -96,17 +96,7 @@ def plot():
         for below_key, above_key, color, width, name in (
                 ("first_crossing_below", "first_crossing_above", "0.75", 4, "crossed at some t̄ ≤ 2"),
                 ("omega_c_below", "omega_c_above", "k", 1.2, "ω̄_c: Δb ≤ 0 at t̄ = 2")):
-            xs, ys, lo, hi = [], [], [], []
-            for r in rows:
-                if not r[above_key]:
-                    continue
-                above = float(r[above_key])
-                below = float(r[below_key]) if r[below_key] else 0.0
-                xs.append(float(r[column]))
-                ys.append(0.5 * (below + above) if r[below_key] else above)
-                lo.append(ys[-1] - below)
-                hi.append(above - ys[-1])
-            ax.errorbar(xs, ys, yerr=[lo, hi], fmt="-", color=color, capsize=3, lw=width, label=name)
+            bracket_errorbar(ax, rows, column, below_key, above_key, fmt="-", color=color, lw=width, label=name)
         finish_crossing_axes(ax, label, "Δt/R = 4: ", legend_loc=where)
     fig.tight_layout()
     fig.savefig(os.path.join(DOCS, "fig9_geometry.png"), dpi=110)
