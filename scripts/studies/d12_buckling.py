@@ -15,8 +15,8 @@ import os
 
 from common import ROOT, bracket_errorbar, case_table, read_csv, sweep_study_main, write_csv
 
-SWEEP = "examples/studies/d12_buckling.toml"
-OUT = os.path.join(ROOT, "out", "studies", "d12")
+SWEEPS = ["examples/studies/d12_buckling.toml", "examples/studies/d12_buckling_small_radius.toml"]
+OUTS = [os.path.join(ROOT, "out", "studies", "d12"), os.path.join(ROOT, "out", "studies", "d12_small_radius")]
 DOCS = os.path.join(ROOT, "docs", "validation")
 CASES = os.path.join(DOCS, "d12_cases.csv")
 CRITICAL = os.path.join(DOCS, "d12_critical.csv")
@@ -37,7 +37,11 @@ def line_values(text):
 
 
 def table():
-    rows, lines = case_table(OUT, "--line", "rods.omega_bar", "--criterion", "buckled")
+    rows, lines = [], []
+    for out_dir in OUTS:
+        r, l = case_table(out_dir, "--line", "rods.omega_bar", "--criterion", "buckled")
+        rows += r
+        lines += l
     out = []
     for r in rows:
         if r["status"] != "completed":
@@ -48,13 +52,16 @@ def table():
     out.sort(key=lambda x: (x[0], float(x[1]), float(x[2]), float(x[3])))
     write_csv(CASES, ["study", "lambda_over_l0", "R_over_lambda", "omega_bar", "buckled",
                       "max_tip_axis_distance_over_R", "final_length_bar", "wall_seconds"], out)
-    crit = []
+    crit = {}  # (study, λ/l0, R/λ) -> row; a line continued in the second sweep: its bracket
     for line in lines:
-        study, lam, ratio = geometry({k: v.strip("'\"") for k, v in line_values(line["line"]).items()})
-        crit.append([study, lam, ratio, line["below"], line["above"], line["estimate"], line["monotone"],
-                     line["points"]])
-        if study == "pitch" and float(lam) == PITCH / L0:  # the shared point is on both panels
-            crit.append(["radius", *crit[-1][1:]])
+        key = geometry({k: v.strip("'\"") for k, v in line_values(line["line"]).items()})
+        if key in crit and not line["above"]:
+            continue
+        crit[key] = [*key, line["below"], line["above"], line["estimate"], line["monotone"], line["points"]]
+    for key, row in list(crit.items()):
+        if key[0] == "pitch" and float(key[1]) == PITCH / L0:  # the shared point is on both panels
+            crit[("radius", *key[1:])] = ["radius", *row[1:]]
+    crit = list(crit.values())
     crit.sort(key=lambda x: (x[0], float(x[1]), float(x[2])))
     write_csv(CRITICAL, ["study", "lambda_over_l0", "R_over_lambda", "omega_b_below", "omega_b_above",
                          "omega_b_estimate", "monotone", "points"], crit)
@@ -87,7 +94,7 @@ def plot():
 
 
 def main():
-    sweep_study_main([SWEEP], table, plot)
+    sweep_study_main(SWEEPS, table, plot)
 
 
 if __name__ == "__main__":
