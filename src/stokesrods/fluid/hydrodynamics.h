@@ -22,6 +22,11 @@ namespace stokesrods {
 
 enum class FluidModel { kNone, kRss, kLsbt, kRft };
 
+/// RSS and LSBT couple every node to every other (a mobility 𝕄); RFT and none are local.
+inline bool IsNonlocal(FluidModel model) {
+  return model == FluidModel::kRss || model == FluidModel::kLsbt;
+}
+
 struct FluidParams {
   FluidModel model = FluidModel::kRss;
   double viscosity = 1.0;       ///< μ [Pa·s]

@@ -97,9 +97,19 @@ class DenseMobility final : public MobilityOperator {
 // pairs to the closed forms. The corrections are stored per target as 3×3 blocks acting on F.
 class MatrixFreeRssMobility final : public MobilityOperator {
  public:
+  // One accuracy at every size: the far field is as accurate as the fast sum's tolerance, so the
+  // quadrature (and the near pairs' closed forms) need not be better either, and the near zone
+  // (exact closed forms, once per step) can shrink. The fast sum adds up directly (in single
+  // precision from 1e-4) below direct_sum_below pairs or where its cost model says the tree
+  // would not pay.
   MatrixFreeRssMobility(const FluidParams& params, const MobilityOptions& options)
-      : params_(params), options_(options), split_(ChooseNearFarSplit(std::max(options.tolerance, options.fast_sum_tolerance),
-                                       options.fast_sum_near_delta)) {}
+      : params_(params),
+        accuracy_(std::max(options.tolerance, options.fast_sum_tolerance)),
+        split_(ChooseNearFarSplit(accuracy_, options.fast_sum_near_delta)),
+        far_(MakeFastStokesletSum(
+            {.tolerance = options.fast_sum_tolerance,
+             .direct_below_pairs = static_cast<std::int64_t>(options.direct_sum_below),
+             .choose_by_cost = options.fast_sum_by_cost})) {}
 
   void Update(const std::vector<HydroRod>& rods) override;
   void Apply(const VecX& force, VecX* velocity) const override;
@@ -118,15 +128,15 @@ class MatrixFreeRssMobility final : public MobilityOperator {
   void FindNearPairs(const Matrix3X& targets);
 
   FluidParams params_;
-  MobilityOptions options_;
+  double accuracy_;                 // of the far field, its quadrature and the near pairs
   NearFarSplit split_;
+  std::unique_ptr<StokesletSum> far_;
   std::vector<HydroRod> rods_;
   Matrix3X nodes_;                  // 3 × M
   VecX inverse_voronoi_;            // 1/Λ_j
   std::vector<Segment> segments_;
   Matrix3X gauss_points_;           // 3 × (segments × points)
   VecX gauss_eps_;
-  std::unique_ptr<StokesletSum> far_;
   // Near corrections: for target t, blocks near_block_[k] acting on node near_source_[k],
   // k ∈ [near_start_[t], near_start_[t + 1]).
   std::vector<int> near_start_, near_source_;
@@ -148,18 +158,6 @@ void MatrixFreeRssMobility::Update(const std::vector<HydroRod>& rods) {
     inverse_voronoi_.segment(first, x.cols()) = VoronoiLengths(x).cwiseInverse();
     const double eps = params_.regularization * rods[static_cast<size_t>(r)].radius;
     for (int j = 0; j + 1 < x.cols(); ++j) segments_.push_back({first + j, eps, r});
-  }
-  if (!far_) {
-    // One accuracy at every size: the far field is as accurate as the fast sum's tolerance, so
-    // the quadrature need not be better either, and the near zone (exact closed forms, once per
-    // step) can shrink. The fast sum adds up directly (in single precision from 1e-4) below
-    // direct_sum_below pairs or where its cost model says the tree would not pay.
-    far_ = MakeFastStokesletSum(
-        {.tolerance = options_.fast_sum_tolerance,
-         .direct_below_pairs = static_cast<std::int64_t>(options_.direct_sum_below),
-         .choose_by_cost = options_.fast_sum_by_cost});
-    split_ = ChooseNearFarSplit(std::max(options_.tolerance, options_.fast_sum_tolerance),
-                                options_.fast_sum_near_delta);
   }
   const double* alpha = nullptr;
   const double* weight = nullptr;
@@ -223,13 +221,12 @@ void MatrixFreeRssMobility::FindNearPairs(const Matrix3X& targets) {
   }
   // The exact near pairs minus the far sum's rule, by rows of RssRowKernel over the range of a
   // rod's segments that are near a target (vectorized; columns of segments in the range that
-  // are not near are left out). "Exact" to the far field's own accuracy: no finer than the sum.
+  // are not near are left out), to the far field's accuracy.
   std::vector<RssRowKernel> kernels;
   for (int r = 0; r < num_rods(); ++r)
     kernels.emplace_back(*rods_[static_cast<size_t>(r)].x,
                          params_.regularization * rods_[static_cast<size_t>(r)].radius,
-                         std::max(params_.far_field_tolerance, options_.fast_sum_tolerance),
-                         split_.gauss_points);
+                         accuracy_, split_.gauss_points);
   const double scale = 1.0 / (8.0 * kPi * params_.viscosity);
   const int m = static_cast<int>(targets.cols());
   std::vector<std::vector<std::pair<int, Mat3>>> per_target(static_cast<size_t>(m));

@@ -81,7 +81,7 @@ class Observer {
     s["newton_iterations"] = result.newton_iterations;
     s["step_reductions"] = result.step_reductions;
     s["wall_seconds"] = result.wall_seconds;
-    if (model_.fluid.model == FluidModel::kRss || model_.fluid.model == FluidModel::kLsbt)
+    if (IsNonlocal(model_.fluid.model))
       s["mobility_reuse"] = {{"updates", result.mobility_reuse.updates},
                              {"assemblies", result.mobility_reuse.assemblies},
                              {"largest_error", result.mobility_reuse.largest_error}};

@@ -13,8 +13,7 @@
 namespace stokesrods {
 
 Workspace::Workspace(const Model& model) : local_forces(MakeLocalForces(model)) {
-  nonlocal_fluid =
-      model.fluid.model == FluidModel::kRss || model.fluid.model == FluidModel::kLsbt;
+  nonlocal_fluid = IsNonlocal(model.fluid.model);
   const int n = model.num_dofs;
   q = q_try = force = residual = residual_try = delta = simplified = contact_force = VecX::Zero(n);
   for (const RodModel& rod : model.rods) jacobian.emplace_back(rod.num_dofs(), 10);
