@@ -12,7 +12,7 @@ namespace stokesrods {
 namespace {
 
 constexpr char kMagic[8] = {'S', 'R', 'C', 'K', 'P', 'T', '\0', '\0'};
-constexpr std::uint32_t kVersion = 3;
+constexpr std::uint32_t kVersion = 4;  // 4: the earlier drags
 constexpr std::uint32_t kOldestVersion = 2;  // without the controls
 
 std::uint64_t Fnv1a(const char* data, std::size_t bytes, std::uint64_t hash = 14695981039346656037ull) {
@@ -154,6 +154,7 @@ void SaveCheckpoint(const std::string& path, const Model& model, const Checkpoin
       w.Raw(load.force.data(), 3 * sizeof(double));
     }
   }
+  for (const VecX& drag : c.history.earlier_drags) w.Vector(drag);
   w.Put(Fnv1a(w.text().data(), w.text().size()));
   WriteFileAtomically(path, w.text());
 }
@@ -209,6 +210,8 @@ Checkpoint LoadCheckpoint(const std::string& path, const Model& model) {
     r.Raw(pose.rotation.data(), 9 * sizeof(double));
   }
   if (version >= 3) c.controls = ReadControls(model, &r);
+  if (version >= 4)
+    for (VecX& drag : c.history.earlier_drags) drag = r.Vector(model.hydro_size(), "an earlier drag", true);
   if (r.at() + sizeof stored_sum != text.size()) r.Fail("unexpected data after the contents");
   return c;
 }

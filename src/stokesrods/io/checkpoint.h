@@ -9,9 +9,12 @@
 // Since version 3 it also holds the controls a caller may change between steps (each rod's
 // rotation rate and point loads; Simulation::SetOmega, SetLoads), which the model fingerprint
 // leaves out. A run from the command line takes them from its configuration; the Python
-// Simulation restores them. Version 2 files (no controls) still read.
+// Simulation restores them. Version 4 adds the drags of the two steps before (the implicit
+// drag's extrapolated first guess, sim/integrator.cc PredictDrag). Version 2 and 3 files still
+// read; resumed from them, the first steps start from a less extrapolated guess, which changes
+// the result within the Newton tolerance only.
 //
-// Format (little-endian, version 3): "SRCKPT\0\0", uint32 version, the payload, then the FNV-1a
+// Format (little-endian, version 4): "SRCKPT\0\0", uint32 version, the payload, then the FNV-1a
 // 64-bit hash of everything before it. Written atomically (temporary file, then rename); a
 // damaged, truncated, foreign or other-version file is refused with an IoError naming it.
 #pragma once

@@ -9,6 +9,7 @@
 // before the step.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -72,6 +73,10 @@ struct Workspace {
   VecX previous_velocity;        ///< q̇(t_{k−1}), for the second-order predictor and BDF2
   VecX previous_q;               ///< q(t_{k−1}), for BDF2
   double previous_h = 0.0;       ///< the step that led to t_k
+  /// The implicit drag at t_{k−1} and t_{k−2}, of steps of size previous_h (empty when unknown):
+  /// the next step's first guess extrapolates the drag through them (PredictDrag).
+  std::array<VecX, 2> earlier_drags;
+  VecX drag_at_start;            ///< the drag at t_k (3M), restored when the step fails
   State step_start;              ///< the start of the step in implicit Euler's form (see Step)
   State step_geometry;           ///< BDF2: the predictor, where 𝕄 and the local drag are taken
   std::vector<BandedMatrix> jacobian;  ///< per rod
@@ -90,6 +95,7 @@ struct StepHistory {
   VecX previous_velocity;   ///< q̇(t_{k−1})
   double previous_h = 0.0;  ///< [s]
   VecX hydro_force;         ///< the nodal drag of the last step (3M; empty without a nonlocal fluid)
+  std::array<VecX, 2> earlier_drags;  ///< the drag at t_{k−1}, t_{k−2} (Workspace)
 };
 StepHistory CaptureHistory(const Workspace& ws);
 void RestoreHistory(const StepHistory& history, Workspace* ws);
