@@ -1,6 +1,6 @@
 // `stokesrods sweep` as users run it: cases in separate processes, failure isolation, resume after
-// a finished or an interrupted sweep, the [refine] bisection, bad sweep files, and the same sweep
-// under mpirun -n 2.
+// a finished or an interrupted sweep, a failed case retried with [[adjust]], the [refine]
+// bisection, bad sweep files, and the same sweep under mpirun -n 2.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -109,6 +109,30 @@ TEST(SweepCli, ARerunSkipsFinishedCasesAndRunsTheMissingOnes) {
   std::ofstream(dir / "base.toml") << std::string(kBase) << "poisson_ratio = 0.4\n";
   const Outcome changed = Shell(dir, cmd);
   EXPECT_NE(changed.err.find("(0 finished before"), std::string::npos) << changed.err;
+}
+
+// A failed case retried with its own settings ([[adjust]]): only it runs again, in its folder.
+TEST(SweepCli, AnAdjustedFailedCaseRunsAgainAndTheOthersAreKept) {
+  const fs::path dir = Dir("adjust");
+  const std::string head = "base = \"base.toml\"\noutput = \"out\"\n[set]\n\"run.time_step\" = 0.025\n"
+                           "[vary]\n\"rods.omega_bar\" = [100, 200]\n[[adjust]]\n"
+                           "where = { \"rods.omega_bar\" = 100 }\n\"solver.newton_max_iterations\" = ";
+  std::ofstream(dir / "s.toml") << head << "1\n";  // one Newton iteration: the case fails
+  const std::string cmd = "cd " + dir.string() + " && " + Sweep(dir / "s.toml");
+  ASSERT_EQ(Shell(dir, cmd).code, 3);
+  const fs::path kept = dir / "out" / "omega_bar=200" / "summary.json";
+  const auto stamp = fs::last_write_time(kept);
+  std::ofstream(dir / "s.toml") << head << "20\n";
+  const Outcome again = Shell(dir, cmd);
+  ASSERT_EQ(again.code, 0) << again.err;
+  EXPECT_NE(again.err.find("2 cases in out (1 finished before, skipped;"), std::string::npos) << again.err;
+  EXPECT_EQ(fs::last_write_time(kept), stamp);
+  const auto rows = ReadCsv(dir / "out" / "sweep.csv");
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].at("case"), "omega_bar=100");
+  EXPECT_EQ(rows[0].at("status"), "completed");
+  EXPECT_NE(Read(dir / "out" / "omega_bar=100" / "summary.json").find("\"newton_max_iterations\": 20"),
+            std::string::npos);
 }
 
 TEST(SweepCli, AnInterruptedSweepKeepsFinishedCasesAndResumesTheOthers) {

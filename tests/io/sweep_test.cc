@@ -111,6 +111,52 @@ TEST(Sweep, BadFilesNameTheKeyAndTheProblem) {
   }
 }
 
+// [[adjust]] sets keys in the matching cases only; the others keep the very overrides they had
+// without it (so their finished runs still count), and no folder name moves.
+TEST(Sweep, AdjustSetsKeysInTheMatchingCasesOnly) {
+  const std::string grid = "[vary]\n\"rods.omega_bar\" = [43, 107]\n\"run.time_step\" = [0.01, 0.02]\n"
+                           "[refine]\nkey = \"rods.omega_bar\"\ncriterion = \"crossed\"\nresolution = 1.0\n";
+  const Sweep plain = Parse(grid);
+  const Sweep s = Parse(grid + "[[adjust]]\nwhere = { \"rods.omega_bar\" = 107.0, \"run.time_step\" = 0.02 }\n"
+                               "\"solver.max_step_halvings\" = 4\n\"solver.newton_max_iterations\" = 40\n"
+                               "[[adjust]]\nwhere = { \"rods.omega_bar\" = 107 }\n\"solver.max_step_halvings\" = 2\n");
+  ASSERT_EQ(s.cases.size(), 4u);
+  const int default_iterations = LoadConfig(s.base, {}).solver.newton_max_iterations;
+  for (std::size_t i = 0; i < 4; ++i) EXPECT_EQ(s.cases[i].name, plain.cases[i].name);
+  EXPECT_EQ(s.cases[0].overrides, plain.cases[0].overrides);  // ω̄ = 43: untouched
+  EXPECT_EQ(s.cases[1].overrides, plain.cases[1].overrides);
+  const Config c2 = LoadConfig(s.base, s.cases[2].overrides);  // 107 at h = 0.01: the second entry
+  EXPECT_EQ(c2.solver.max_step_halvings, 2);
+  EXPECT_EQ(c2.solver.newton_max_iterations, default_iterations);
+  const Config c3 = LoadConfig(s.base, s.cases[3].overrides);  // both match: the later one wins
+  EXPECT_EQ(c3.solver.max_step_halvings, 2);
+  EXPECT_EQ(c3.solver.newton_max_iterations, 40);
+  // A refinement case made later matches the same way (75 is on no entry's line of 107).
+  const SweepCase mid = MakeSweepCase(s, "", {{"rods.omega_bar", "75"}, {"run.time_step", "0.02"}});
+  EXPECT_EQ(mid.overrides, MakeSweepCase(plain, "", {{"rods.omega_bar", "75"}, {"run.time_step", "0.02"}}).overrides);
+  // sweep.json keeps the entries.
+  WriteSweepJson(s);
+  const Sweep read = ReadSweepJson(s.output);
+  ASSERT_EQ(read.adjustments.size(), 2u);
+  EXPECT_EQ(read.adjustments[0].where, s.adjustments[0].where);
+  EXPECT_EQ(read.adjustments[0].overrides, s.adjustments[0].overrides);
+}
+
+TEST(Sweep, BadAdjustEntriesNameTheKeyAndTheProblem) {
+  const std::string grid = "[vary]\n\"rods.omega_bar\" = [43, 107]\n[[adjust]]\n";
+  EXPECT_NE(ErrorOf(grid + "\"solver.max_step_halvings\" = 4\n").find("adjust.where | "), std::string::npos);
+  EXPECT_NE(ErrorOf(grid + "where = { \"run.time_step\" = 0.01 }\n\"solver.max_step_halvings\" = 4\n")
+                .find("adjust.where.run.time_step | "), std::string::npos);
+  EXPECT_NE(ErrorOf(grid + "where = { \"rods.omega_bar\" = 43 }\n\"rods.omega_bar\" = 44\n")
+                .find("adjust.rods.omega_bar | "), std::string::npos);
+  EXPECT_NE(ErrorOf(grid + "where = { \"rods.omega_bar\" = 43 }\n").find("sets no key"), std::string::npos);
+  EXPECT_NE(ErrorOf(grid + "where = { \"rods.omega_bar\" = 44 }\n\"solver.max_step_halvings\" = 4\n")
+                .find("entry 1 matches no case"), std::string::npos);
+  const std::string bad_key = ErrorOf(grid + "where = { \"rods.omega_bar\" = 43 }\n\"solver.max_halvings\" = 4\n");
+  EXPECT_NE(bad_key.find("max_halvings"), std::string::npos) << bad_key;
+  EXPECT_NE(bad_key.find("case omega_bar=43"), std::string::npos) << bad_key;
+}
+
 TEST(Sweep, ExitCodesMapToStatuses) {
   EXPECT_EQ(MakeCaseRecord(0, 0, 1.0, "").status, "completed");
   EXPECT_EQ(MakeCaseRecord(3, 0, 1.0, "").status, "failed");

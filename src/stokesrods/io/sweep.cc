@@ -1,6 +1,7 @@
 #include "stokesrods/io/sweep.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -111,6 +112,62 @@ std::vector<CaseSpec> ReadCases(const toml::table& root, const std::string& file
 
 std::string Override(const std::string& key, const std::string& text) { return key + "=" + text; }
 
+bool IsVaried(const Sweep& sweep, const std::string& key) {
+  return std::find(sweep.varied_keys.begin(), sweep.varied_keys.end(), key) != sweep.varied_keys.end();
+}
+
+// [[adjust]]: `where` names varied keys only, the other keys are not varied ones.
+std::vector<SweepAdjust> ReadAdjustments(const toml::table& root, const Sweep& sweep) {
+  const toml::node* node = root.get("adjust");
+  if (node == nullptr) return {};
+  const std::string& file = sweep.file;
+  if (!node->is_array_of_tables() || node->as_array()->empty())
+    throw ConfigError(file, "adjust", "expected one or more [[adjust]] tables");
+  std::vector<SweepAdjust> adjustments;
+  for (const auto& entry : *node->as_array()) {
+    toml::table keys = *entry.as_table();
+    const toml::node* where = keys.get("where");
+    if (where == nullptr || !where->is_table() || where->as_table()->empty())
+      throw ConfigError(file, "adjust.where", "expected a table of varied keys and the values that select the cases");
+    SweepAdjust adjust;
+    KeyValues selected, set;
+    Flatten(*where->as_table(), "", &selected);
+    for (const auto& [key, value] : selected) {
+      if (!IsVaried(sweep, key))
+        throw ConfigError(file, "adjust.where." + key, "not a varied key ([[cases]] or [vary]): it selects no case");
+      adjust.where.emplace_back(key, TomlText(*value));
+    }
+    keys.erase("where");
+    Flatten(keys, "", &set);
+    if (set.empty()) throw ConfigError(file, "adjust", "an [[adjust]] entry sets no key besides `where`");
+    for (const auto& [key, value] : set) {
+      if (IsVaried(sweep, key))
+        throw ConfigError(file, "adjust." + key, "a varied key: give its values in [[cases]] or [vary]");
+      adjust.overrides.push_back(Override(key, TomlText(*value)));
+    }
+    adjustments.push_back(std::move(adjust));
+  }
+  return adjustments;
+}
+
+// Two values as TOML text: numbers compare as numbers (550 and 550.0 are the same), others as text.
+bool SameValue(const std::string& a, const std::string& b) {
+  char* end_a = nullptr;
+  char* end_b = nullptr;
+  const double x = std::strtod(a.c_str(), &end_a);
+  const double y = std::strtod(b.c_str(), &end_b);
+  const bool numbers = !a.empty() && !b.empty() && *end_a == '\0' && *end_b == '\0';
+  return numbers ? x == y : a == b;
+}
+
+bool Matches(const SweepAdjust& adjust, const std::vector<std::pair<std::string, std::string>>& values) {
+  for (const auto& [key, text] : adjust.where) {
+    const auto it = std::find_if(values.begin(), values.end(), [&](const auto& kv) { return kv.first == key; });
+    if (it == values.end() || !SameValue(it->second, text)) return false;
+  }
+  return true;
+}
+
 std::optional<RefineSpec> ReadRefine(const toml::table& root, const Sweep& sweep) {
   const toml::node* node = root.get("refine");
   if (node == nullptr) return std::nullopt;
@@ -133,11 +190,11 @@ std::optional<RefineSpec> ReadRefine(const toml::table& root, const Sweep& sweep
   return spec;
 }
 
+}  // namespace
+
 std::string OutputOverride(const std::string& dir) {
   return "run.output=" + TomlText(toml::value<std::string>(dir));
 }
-
-}  // namespace
 
 Sweep ParseSweep(const std::string& toml_text, const std::string& file, const std::string& dir,
                  const std::string& output) {
@@ -147,10 +204,11 @@ Sweep ParseSweep(const std::string& toml_text, const std::string& file, const st
   } catch (const toml::parse_error& e) {
     throw ConfigError(file, fmt::format("line {}", e.source().begin.line), std::string(e.description()));
   }
-  static const std::set<std::string> kKeys = {"base", "output", "set", "vary", "cases", "refine"};
+  static const std::set<std::string> kKeys = {"base", "output", "set", "vary", "cases", "adjust", "refine"};
   for (const auto& [key, node] : root)
     if (kKeys.count(std::string(key.str())) == 0)
-      throw ConfigError(file, std::string(key.str()), "unknown key (known: base, output, set, vary, cases, refine)");
+      throw ConfigError(file, std::string(key.str()),
+                        "unknown key (known: base, output, set, vary, cases, adjust, refine)");
   Sweep sweep;
   sweep.file = file;
   const auto base = root["base"].value<std::string>();
@@ -180,6 +238,7 @@ Sweep ParseSweep(const std::string& toml_text, const std::string& file, const st
   for (const auto& kv : varied) sweep.varied_keys.push_back(kv.first);
   for (const auto& [key, node] : fixed) sweep.fixed_overrides.push_back(Override(key, TomlText(*node)));
   sweep.refine = ReadRefine(root, sweep);
+  sweep.adjustments = ReadAdjustments(root, sweep);
 
   std::set<std::string> names;
   for (const CaseSpec& spec : specs) {
@@ -204,6 +263,11 @@ Sweep ParseSweep(const std::string& toml_text, const std::string& file, const st
       }
     }
   }
+  for (std::size_t i = 0; i < sweep.adjustments.size(); ++i) {
+    const auto matches = [&](const SweepCase& c) { return Matches(sweep.adjustments[i], c.values); };
+    if (std::none_of(sweep.cases.begin(), sweep.cases.end(), matches))
+      throw ConfigError(file, "adjust", fmt::format("[[adjust]] entry {} matches no case", i + 1));
+  }
   for (const SweepCase& c : sweep.cases) {
     try {
       LoadConfig(sweep.base, c.overrides);
@@ -219,6 +283,8 @@ SweepCase MakeSweepCase(const Sweep& sweep, const std::string& prefix,
   SweepCase c;
   c.prefix = prefix;
   c.overrides = sweep.fixed_overrides;
+  for (const SweepAdjust& adjust : sweep.adjustments)
+    if (Matches(adjust, values)) c.overrides.insert(c.overrides.end(), adjust.overrides.begin(), adjust.overrides.end());
   for (const auto& [key, text] : values) c.overrides.push_back(Override(key, text));
   c.values = std::move(values);
   c.name = FolderName(prefix, c.values);
@@ -248,6 +314,8 @@ void WriteSweepJson(const Sweep& sweep) {
                                               {"criterion", sweep.refine->criterion},
                                               {"resolution", sweep.refine->resolution}}
                              : nlohmann::json();
+  j["adjust"] = nlohmann::json::array();
+  for (const SweepAdjust& a : sweep.adjustments) j["adjust"].push_back({{"where", a.where}, {"overrides", a.overrides}});
   j["cases"] = nlohmann::json::array();
   for (const SweepCase& c : sweep.cases) j["cases"].push_back(CaseToJson(c));
   std::error_code ec;
@@ -272,6 +340,9 @@ Sweep ReadSweepJson(const std::string& dir) {
       sweep.refine = RefineSpec{j["refine"].at("key").get<std::string>(),
                                 j["refine"].at("criterion").get<std::string>(),
                                 j["refine"].at("resolution").get<double>()};
+    for (const nlohmann::json& a : j.value("adjust", nlohmann::json::array()))  // absent before [[adjust]]
+      sweep.adjustments.push_back({a.at("where").get<std::vector<std::pair<std::string, std::string>>>(),
+                                   a.at("overrides").get<std::vector<std::string>>()});
     for (const nlohmann::json& c : j.at("cases")) {
       sweep.cases.push_back(CaseFromJson(c));
       sweep.cases.back().output_dir = (fs::path(dir) / sweep.cases.back().name).string();
@@ -296,104 +367,6 @@ std::vector<std::string> CaseArguments(const Sweep& sweep, const SweepCase& c, b
   }
   if (resume) args.push_back("--resume");
   return args;
-}
-
-CaseRecord MakeCaseRecord(int exit_code, int signal, double wall_seconds,
-                          const std::string& summary_text) {
-  CaseRecord r;
-  r.exit_code = signal != 0 ? 128 + signal : exit_code;
-  r.wall_seconds = wall_seconds;
-  nlohmann::json summary;
-  if (!summary_text.empty()) summary = nlohmann::json::parse(summary_text, nullptr, false);
-  if (summary.is_object()) {
-    r.message = summary.value("message", "");
-    if (summary.contains("final") && summary["final"].is_object()) r.final_values = summary["final"];
-  }
-  if (signal != 0) {
-    r.status = "crashed";
-    r.message = fmt::format("killed by signal {}", signal);
-  } else if (exit_code == 0) {
-    r.status = "completed";
-  } else if (exit_code == 3) {
-    r.status = "failed";
-  } else if (exit_code == 130) {
-    r.status = "interrupted";
-  } else if (exit_code == 2 || exit_code == 4) {
-    r.status = "error";
-    if (r.message.empty()) r.message = fmt::format("exit code {}; see run.log", exit_code);
-  } else {
-    r.status = "crashed";
-    r.message = fmt::format("exit code {}; see run.log", exit_code);
-  }
-  return r;
-}
-
-CaseRecord ReadCaseRecord(const Sweep& sweep, const SweepCase& c) {
-  CaseRecord pending;
-  std::ifstream in(fs::path(c.output_dir) / "summary.json");
-  if (!in) return pending;
-  const nlohmann::json summary = nlohmann::json::parse(in, nullptr, false);
-  if (!summary.is_object() || !summary.contains("config")) return pending;
-  std::vector<std::string> overrides = c.overrides;
-  overrides.push_back(OutputOverride(c.output_dir));
-  const nlohmann::json now = nlohmann::json::parse(ConfigToJson(LoadConfig(sweep.base, overrides)));
-  if (!SameRunSettings(summary["config"], now)) return pending;  // another configuration: rerun
-  const std::string status = summary.value("status", "");
-  const int code = status == "completed" ? 0 : status == "failed" ? 3 : 130;
-  CaseRecord r = MakeCaseRecord(code, 0, summary.value("wall_seconds", 0.0), summary.dump());
-  if (status == "interrupted") {
-    r.resumable = fs::exists(fs::path(c.output_dir) / "checkpoint.bin");
-    if (!r.resumable) return pending;
-  }
-  return r;
-}
-
-namespace {
-
-std::string CsvField(const std::string& text) {
-  if (text.find_first_of(",\"\n") == std::string::npos) return text;
-  std::string quoted = "\"";
-  for (char ch : text) quoted += ch == '"' ? std::string("\"\"") : std::string(1, ch == '\n' ? ' ' : ch);
-  return quoted + "\"";
-}
-
-std::string CsvNumber(const nlohmann::json& v) {
-  if (v.is_number()) return fmt::format("{:.17g}", v.get<double>());
-  return v.is_null() ? std::string() : CsvField(v.dump());
-}
-
-}  // namespace
-
-void WriteSweepCsv(const Sweep& sweep, const std::vector<CaseRecord>& records) {
-  std::vector<std::string> final_columns;
-  std::set<std::string> seen;
-  for (const CaseRecord& r : records)
-    for (const auto& [key, value] : r.final_values.items())
-      if (seen.insert(key).second) final_columns.push_back(key);
-  std::string text = "case";
-  for (const std::string& k : sweep.varied_keys) text += "," + CsvField(k);
-  text += ",status,exit_code,wall_seconds,rank,message";
-  for (const std::string& k : final_columns) text += "," + CsvField(k);
-  text += "\n";
-  for (std::size_t i = 0; i < sweep.cases.size(); ++i) {
-    const SweepCase& c = sweep.cases[i];
-    const CaseRecord& r = records[i];
-    text += CsvField(c.name);
-    for (const std::string& k : sweep.varied_keys) {
-      std::string value;
-      for (const auto& [key, t] : c.values)
-        if (key == k) value = t;
-      text += "," + CsvField(value);
-    }
-    text += fmt::format(",{},{},{:.3f},{},{}", r.status, r.exit_code, r.wall_seconds, r.rank,
-                        CsvField(r.message));
-    for (const std::string& k : final_columns)
-      text += "," + (r.final_values.contains(k) ? CsvNumber(r.final_values[k]) : std::string());
-    text += "\n";
-  }
-  std::error_code ec;
-  fs::create_directories(sweep.output, ec);
-  WriteFileAtomically((fs::path(sweep.output) / "sweep.csv").string(), text);
 }
 
 }  // namespace stokesrods

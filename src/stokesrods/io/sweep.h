@@ -11,6 +11,9 @@
 //   [[cases]]                   # explicit cases (extension); the product is taken for each case
 //   "rods.2.base" = [0.04, 0.0, 0.0]
 //   name = "dt4"                # optional folder-name prefix of the case
+//   [[adjust]]                  # keys for the matching cases only (extension), e.g. to retry
+//   where = { "rods.omega_bar" = 107 }   # a failed case without touching the others
+//   "solver.max_step_halvings" = 4
 //   [refine]                    # bisection along a line after the grid (extension)
 //   key = "rods.omega_bar"
 //   criterion = "crossed"       # or "buckled"
@@ -44,17 +47,27 @@ struct RefineSpec {
   double resolution = 0.0;
 };
 
+/// [[adjust]]: keys set in the cases whose varied values match every entry of `where` (numbers
+/// compare as numbers: 550 matches 550.0). They do not enter the folder name, so an adjusted case
+/// keeps its folder, and its old summary (another configuration) no longer counts: it runs again.
+struct SweepAdjust {
+  std::vector<std::pair<std::string, std::string>> where;  ///< varied key, value as TOML text
+  std::vector<std::string> overrides;                       ///< "key=value", applied after [set]
+};
+
 struct Sweep {
   std::string file;                      ///< the sweep file (for messages)
   std::string base;                      ///< the base configuration's path
   std::string output;                    ///< the sweep's folder
   std::vector<std::string> varied_keys;  ///< sweep.csv's key columns
   std::vector<std::string> fixed_overrides;  ///< [set]
+  std::vector<SweepAdjust> adjustments;      ///< [[adjust]], in file order (a later one wins)
   std::optional<RefineSpec> refine;
   std::vector<SweepCase> cases;
 };
 
-/// The case with these values (key, TOML text) of the varied keys, after the sweep's [set].
+/// The case with these values (key, TOML text) of the varied keys, after the sweep's [set] and the
+/// [[adjust]] entries it matches.
 SweepCase MakeSweepCase(const Sweep& sweep, const std::string& prefix,
                         std::vector<std::pair<std::string, std::string>> values);
 
@@ -101,6 +114,9 @@ CaseRecord ReadCaseRecord(const Sweep& sweep, const SweepCase& c);
 /// `wall_seconds`; `summary_text` is its summary.json if any ("" if none).
 CaseRecord MakeCaseRecord(int exit_code, int signal, double wall_seconds,
                           const std::string& summary_text);
+
+/// The --set that puts a case's run in `dir` (run.output as TOML text).
+std::string OutputOverride(const std::string& dir);
 
 /// The command-line arguments (after the program) that run case `c`.
 std::vector<std::string> CaseArguments(const Sweep& sweep, const SweepCase& c, bool resume);
