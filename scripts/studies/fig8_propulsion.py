@@ -6,6 +6,9 @@
   fig8_propulsion.py table   docs/validation/fig8_single_cases.csv, fig8b_cases.csv (stokesrods analyze)
                              and the summary fig8_propulsion.csv (fits of those and of fig7c3_cases.csv)
   fig8_propulsion.py plot    docs/validation/fig8_propulsion.png from those tables alone
+  fig8_propulsion.py table also writes, when their run folders exist, the checks of Fig. 8(b)'s rise
+                             from Δt/R = 3 to 50: fig8b_windows.csv (over which times F̄p is averaged,
+                             from out/studies/fig8b) and fig8b_sensitivity.csv (fig8b_sensitivity.toml)
 
 F̄p (eq. 26, both rods' clamp reactions along z over EI/l0²) is the time average over the second half
 of each run (t̄ ∈ [1, 2]); `stokesrods analyze` computes it and its ratio to one flagellum at the
@@ -25,6 +28,9 @@ SINGLE = os.path.join(DOCS, "fig8_single_cases.csv")
 PAIRS = os.path.join(DOCS, "fig7c3_cases.csv")
 FAR = os.path.join(DOCS, "fig8b_cases.csv")
 SUMMARY = os.path.join(DOCS, "fig8_propulsion.csv")
+WINDOWS = os.path.join(DOCS, "fig8b_windows.csv")
+SENSITIVITY = os.path.join(DOCS, "fig8b_sensitivity.csv")
+RISE_ENDS = ("0.03", "0.5")  # rods.2.base x of Δt/R = 3 and 50
 R = 0.01
 PAPER_REDUCTION = {4: 40.0, 6: 31.7, 8: 20.2}
 FORCE = ["propulsive_force_bar_mean", "propulsive_force_bar_final"]
@@ -44,6 +50,42 @@ def table():
     write_csv(SUMMARY, ["delta_t_over_R", "points", "speeds", "slope_of_mean", "reduction_percent",
                         "paper_reduction_percent", "slope_of_final", "reduction_of_final_percent"],
               summary_rows(series()))
+    rise_tables()
+
+
+def rise_tables():
+    """Fig. 8(b)'s rise F̄p(50)/F̄p(3) − 1: by averaging window (and the value at single times), and
+    with one modelling choice changed at a time (fig8b_sensitivity.toml's cases, means over t̄ ∈ [1, 2])."""
+    from common import timeseries
+    ends = [os.path.join(OUT, "fig8b", f"rod2.base=_{x}_0.0_0.0_") for x in RISE_ENDS]
+    if all(os.path.exists(os.path.join(e, "timeseries.csv")) for e in ends):
+        series3, series50 = [timeseries(e) for e in ends]
+        rows = []
+        for a, b in ((0.0, 2.0), (0.25, 2.0), (0.5, 2.0), (1.0, 2.0), (0.02, 0.02), (0.1, 0.1), (0.25, 0.25),
+                     (2.0, 2.0)):
+            f3, f50 = window_mean(series3, a, b), window_mean(series50, a, b)
+            rows.append([f"{a:g}", f"{b:g}", f"{f3:.5g}", f"{f50:.5g}", f"{100 * (f50 / f3 - 1):.1f}"])
+        write_csv(WINDOWS, ["t_bar_from", "t_bar_to", "F_p_bar_at_3", "F_p_bar_at_50", "rise_percent"], rows)
+    runs, _ = case_table(os.path.join(OUT, "fig8b_sensitivity"))
+    far, _ = case_table(os.path.join(OUT, "fig8b"))
+    by_variant = {}
+    for r in [dict(r, case="base__" + r["case"]) for r in far] + runs:
+        x = r["rods.2.base"].strip("[] ").split(",")[0].strip()
+        if r["status"] == "completed" and x in RISE_ENDS:
+            by_variant.setdefault(r["case"].split("__")[0], {})[x] = float(r["propulsive_force_bar_mean"])
+    rows = [[v, f"{f[RISE_ENDS[0]]:.5g}", f"{f[RISE_ENDS[1]]:.5g}", f"{100 * (f[RISE_ENDS[1]] / f[RISE_ENDS[0]] - 1):.1f}"]
+            for v, f in by_variant.items() if len(f) == 2]
+    if runs:
+        write_csv(SENSITIVITY, ["variant", "F_p_bar_at_3", "F_p_bar_at_50", "rise_percent"], rows)
+
+
+def window_mean(series, a, b):
+    """F̄p averaged (trapezoids) over t̄ ∈ [a, b], or its value at the row nearest a when a = b."""
+    t, f = series["t_bar"], series["propulsive_force_bar"]
+    if a == b:
+        return float(f[np.argmin(abs(t - a))])
+    inside = (t >= max(a, t[1]) - 1e-9) & (t <= b + 1e-9)  # the row at t = 0 has no force yet
+    return float(np.trapz(f[inside], t[inside]) / (t[inside][-1] - t[inside][0]))
 
 
 def series():
