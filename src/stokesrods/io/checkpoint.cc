@@ -12,7 +12,7 @@ namespace stokesrods {
 namespace {
 
 constexpr char kMagic[8] = {'S', 'R', 'C', 'K', 'P', 'T', '\0', '\0'};
-constexpr std::uint32_t kVersion = 4;  // 4: the earlier drags
+constexpr std::uint32_t kVersion = 5;  // 4: the earlier drags; 5: the bodies' previous poses
 constexpr std::uint32_t kOldestVersion = 2;  // without the controls
 
 std::uint64_t Fnv1a(const char* data, std::size_t bytes, std::uint64_t hash = 14695981039346656037ull) {
@@ -155,6 +155,11 @@ void SaveCheckpoint(const std::string& path, const Model& model, const Checkpoin
     }
   }
   for (const VecX& drag : c.history.earlier_drags) w.Vector(drag);
+  w.Put(static_cast<std::int64_t>(c.history.previous_poses.size()));  // version 5
+  for (const BodyPose& pose : c.history.previous_poses) {
+    w.Raw(pose.center.data(), 3 * sizeof(double));
+    w.Raw(pose.rotation.data(), 9 * sizeof(double));
+  }
   w.Put(Fnv1a(w.text().data(), w.text().size()));
   WriteFileAtomically(path, w.text());
 }
@@ -212,6 +217,17 @@ Checkpoint LoadCheckpoint(const std::string& path, const Model& model) {
   if (version >= 3) c.controls = ReadControls(model, &r);
   if (version >= 4)
     for (VecX& drag : c.history.earlier_drags) drag = r.Vector(model.hydro_size(), "an earlier drag", true);
+  if (version >= 5) {  // BDF2's previous poses of the bodies: none, or one per body
+    const auto count = r.Get<std::int64_t>();
+    if (count != 0 && count != static_cast<std::int64_t>(model.bodies.size()))
+      r.Fail(fmt::format("{} previous body poses for a model of {} bodies", count, model.bodies.size()));
+    c.history.previous_poses.resize(static_cast<std::size_t>(count));
+    for (BodyPose& pose : c.history.previous_poses) {
+      if (r.at() + 12 * sizeof(double) + sizeof stored_sum > text.size()) r.Fail("truncated");
+      r.Raw(pose.center.data(), 3 * sizeof(double));
+      r.Raw(pose.rotation.data(), 9 * sizeof(double));
+    }
+  }
   if (r.at() + sizeof stored_sum != text.size()) r.Fail("unexpected data after the contents");
   return c;
 }

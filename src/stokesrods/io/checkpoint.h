@@ -12,9 +12,11 @@
 // Simulation restores them. Version 4 adds the drags of the two steps before (the implicit
 // drag's extrapolated first guess, sim/integrator.cc PredictDrag). Version 2 and 3 files still
 // read; resumed from them, the first steps start from a less extrapolated guess, which changes
-// the result within the Newton tolerance only.
+// the result within the Newton tolerance only. Version 5 adds the bodies' poses at t_{k−1} (BDF2
+// with free bodies); resumed from an older file, BDF2 with free bodies takes one implicit Euler
+// step first.
 //
-// Format (little-endian, version 4): "SRCKPT\0\0", uint32 version, the payload, then the FNV-1a
+// Format (little-endian, version 5): "SRCKPT\0\0", uint32 version, the payload, then the FNV-1a
 // 64-bit hash of everything before it. Written atomically (temporary file, then rename); a
 // damaged, truncated, foreign or other-version file is refused with an IoError naming it.
 #pragma once

@@ -28,10 +28,6 @@ void ValidateBody(const Config& config, const std::string& p, const BodyConfig& 
   if (kMotions.count(body.motion) == 0)
     throw ConfigError(file, p + ".motion",
                       fmt::format("\"{}\" is not one of \"fixed\", \"free\", \"prescribed\"", body.motion));
-  if (body.motion == "free" && config.run.integrator == "bdf2")
-    throw ConfigError(file, "run.integrator",
-                      "\"bdf2\" does not take free bodies yet (their pose at the predictor); use "
-                      "\"euler\"");
   if (body.motion != "prescribed" && (body.velocity != Vec3::Zero() || body.angular_velocity != Vec3::Zero()))
     throw ConfigError(file, p + (body.velocity != Vec3::Zero() ? ".velocity" : ".angular_velocity"),
                       "only for motion = \"prescribed\"");

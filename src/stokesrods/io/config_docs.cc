@@ -75,7 +75,7 @@ const std::map<std::string, std::string>& Meanings() {
       {"bodies.shape", "\"sphere\""},
       {"bodies.radius", "a [m]"},
       {"bodies.center", "centre at the start [m]"},
-      {"bodies.motion", "\"fixed\", \"prescribed\" (velocity and angular_velocity) or \"free\" (force- and torque-free together with the rods on it: carried by the flow, or swimming; run.integrator = \"euler\")"},
+      {"bodies.motion", "\"fixed\", \"prescribed\" (velocity and angular_velocity) or \"free\" (force- and torque-free together with the rods on it: carried by the flow, or swimming)"},
       {"bodies.velocity", "U [m/s] of the centre, motion = \"prescribed\" only"},
       {"bodies.angular_velocity", "Ω [rad/s] about the centre, motion = \"prescribed\" only"},
       {"bodies.surface_points", "regularized Stokeslets on the surface (Fibonacci points, ε = 0.3 × their spacing; drag ~1.4 % low at 400, first order)"},

@@ -45,15 +45,42 @@ Vec6 BodyVelocity(const Model& model, int k, const VecX& f) {
   return f.segment<6>(3 * model.num_hydro_points() + 6 * body.free_index);
 }
 
+namespace {
+
+// c ← c + hU, R ← exp(h[Ω]×)R.
+void AdvanceBody(const Vec6& v, double h, BodyPose* pose) {
+  pose->center += h * v.head<3>();
+  const double angle = h * v.tail<3>().norm();
+  if (angle > 0.0)
+    pose->rotation = Eigen::AngleAxisd(angle, v.tail<3>().normalized()).toRotationMatrix() *
+                     pose->rotation;
+}
+
+}  // namespace
+
 void AdvanceBodies(const Model& model, double h, const VecX& f, std::vector<BodyPose>* poses) {
+  for (int k = 0; k < static_cast<int>(model.bodies.size()); ++k)
+    AdvanceBody(BodyVelocity(model, k, f), h, &(*poses)[static_cast<size_t>(k)]);
+}
+
+BodyPose Bdf2StartPose(const BodyPose& current, const BodyPose& previous) {
+  BodyPose start;
+  start.center = (4.0 * current.center - previous.center) / 3.0;
+  const Eigen::AngleAxisd back(Mat3(previous.rotation * current.rotation.transpose()));
+  start.rotation = Eigen::AngleAxisd(-back.angle() / 3.0, back.axis()).toRotationMatrix() *
+                   current.rotation;
+  return start;
+}
+
+void EndPoses(const Model& model, const BodyStep& step, const VecX& f,
+              std::vector<BodyPose>* poses) {
+  *poses = step.current;
   for (int k = 0; k < static_cast<int>(model.bodies.size()); ++k) {
-    const Vec6 v = BodyVelocity(model, k, f);
-    BodyPose& pose = (*poses)[static_cast<size_t>(k)];
-    pose.center += h * v.head<3>();
-    const double angle = h * v.tail<3>().norm();
-    if (angle > 0.0)
-      pose.rotation = Eigen::AngleAxisd(angle, v.tail<3>().normalized()).toRotationMatrix() *
-                      pose.rotation;
+    const auto i = static_cast<std::size_t>(k);
+    if (model.bodies[i].motion == BodyMotion::kFree)
+      (*poses)[i] = step.start[i], AdvanceBody(BodyVelocity(model, k, f), step.he, &(*poses)[i]);
+    else
+      AdvanceBody(BodyVelocity(model, k, f), step.h, &(*poses)[i]);
   }
 }
 
@@ -86,17 +113,16 @@ void DriveBodyClamps(const Model& model, const std::vector<BodyPose>& from,
                 to[static_cast<std::size_t>(rod.body)], q);
 }
 
-void PlaceFreeClamps(const Model& model, const VecX& start_q,
-                     const std::vector<BodyPose>& start_poses, double h, const VecX& f, VecX* q) {
-  std::vector<BodyPose> next = start_poses;
-  AdvanceBodies(model, h, f, &next);
+void PlaceFreeClamps(const Model& model, const BodyStep& step, const VecX& f, VecX* q) {
+  std::vector<BodyPose> next;
+  EndPoses(model, step, f, &next);
   for (const RodModel& rod : model.rods) {
     if (rod.body < 0 || model.bodies[static_cast<std::size_t>(rod.body)].motion != BodyMotion::kFree)
       continue;
-    for (int k : rod.fixed_dofs) (*q)(rod.dof_offset + k) = start_q(rod.dof_offset + k);
-    if (rod.clamped_nodes >= 2) (*q)(rod.dof_offset + TwistDof(0)) += h * rod.twist_rate;
+    for (int k : rod.fixed_dofs) (*q)(rod.dof_offset + k) = step.current_q(rod.dof_offset + k);
+    if (rod.clamped_nodes >= 2) (*q)(rod.dof_offset + TwistDof(0)) += step.h * rod.twist_rate;
     const auto k = static_cast<std::size_t>(rod.body);
-    MoveClamp(rod, start_poses[k], next[k], q);
+    MoveClamp(rod, step.current[k], next[k], q);
   }
 }
 

@@ -29,6 +29,31 @@ Vec6 BodyVelocity(const Model& model, int body, const VecX& f);
 /// The poses after a step of size h with the velocities of f.
 void AdvanceBodies(const Model& model, double h, const VecX& f, std::vector<BodyPose>* poses);
 
+/// How the bodies move in one step of the integrator (docs/model.md, "Rods on a free body").
+/// Every step is solved in implicit Euler's form: a free body goes from `start` by h_e V,
+///   c_{k+1} = c̃ + h_e U,   R_{k+1} = exp(h_e [Ω]×) R̃,
+/// with (c̃, R̃) its pose at t_k and h_e = h (implicit Euler) or Bdf2StartPose and h_e = 2h/3
+/// (BDF2). Fixed and prescribed bodies go from t_k by h V (exact for their constant motion). The
+/// clamps of rods on a body are moved rigidly from its pose at t_k (`current`, `current_q`).
+struct BodyStep {
+  std::vector<BodyPose> current;   ///< at t_k
+  std::vector<BodyPose> start;     ///< the free bodies' start in implicit Euler's form
+  std::vector<BodyPose> geometry;  ///< where 𝕄, the bodies' points and the balances' torques are
+                                   ///< taken: t_k (implicit Euler) or the predictor (BDF2)
+  VecX current_q;                  ///< q at t_k (with rods on free bodies: their clamps' origin)
+  double h = 0.0;                  ///< the step [s] (the motors turn by h ω')
+  double he = 0.0;                 ///< its implicit-Euler form [s]
+};
+
+/// BDF2's start pose from the poses at t_k and t_{k−1}: c̃ = (4c_k − c_{k−1})/3 and
+/// R̃ = exp(−[φ]×/3) R_k, φ = log(R_{k−1} R_kᵀ) the rotation vector from R_k back to R_{k−1}
+/// (BDF2 on the rotation vector relative to R_k, whose value at t_k is 0).
+BodyPose Bdf2StartPose(const BodyPose& current, const BodyPose& previous);
+
+/// The poses at the end of `step` with the velocities of f.
+void EndPoses(const Model& model, const BodyStep& step, const VecX& f,
+              std::vector<BodyPose>* poses);
+
 /// Moves the clamps of rods on moving bodies (prescribed, or free with a guess of V) from the
 /// poses `from` to `to`: the clamped nodes rigidly with the body, and θ0 by the body's spin about
 /// the first edge (the angle about the new tangent between the parallel transport of the old frame
@@ -36,11 +61,10 @@ void AdvanceBodies(const Model& model, double h, const VecX& f, std::vector<Body
 void DriveBodyClamps(const Model& model, const std::vector<BodyPose>& from,
                      const std::vector<BodyPose>& to, VecX* q);
 
-/// The clamps of rods on free bodies at the end of a step from `start_q` and `start_poses` with the
-/// bodies' V in f: Φ(V) of sim/clamp_border.h, as Step's DriveBoundaryConditions and
-/// DriveBodyClamps place them (the motor's turn, then the body's rigid motion).
-void PlaceFreeClamps(const Model& model, const VecX& start_q,
-                     const std::vector<BodyPose>& start_poses, double h, const VecX& f, VecX* q);
+/// The clamps of rods on free bodies at the end of `step` with the bodies' V in f: Φ(V) of
+/// sim/clamp_border.h, as Step's DriveBoundaryConditions and DriveBodyClamps place them (the
+/// motor's turn by h ω', then the body's rigid motion from its pose at t_k to EndPoses').
+void PlaceFreeClamps(const Model& model, const BodyStep& step, const VecX& f, VecX* q);
 
 /// Force and torque (about the centre) of the fluid on body k at `pose` from f [N, N·m].
 Vec6 BodyHydroLoad(const Model& model, int body, const BodyPose& pose, const VecX& f);

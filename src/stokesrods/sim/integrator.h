@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "stokesrods/sim/bodies.h"
 #include "stokesrods/sim/clamp_border.h"
 #include "stokesrods/sim/contact_forces.h"
 #include "stokesrods/sim/forces.h"
@@ -77,6 +78,8 @@ struct Workspace {
   /// the next step's first guess extrapolates the drag through them (PredictDrag).
   std::array<VecX, 2> earlier_drags;
   VecX drag_at_start;            ///< the drag at t_k (3M), restored when the step fails
+  std::vector<BodyPose> previous_poses;  ///< the bodies at t_{k−1}, for BDF2
+  BodyStep body_step;            ///< how the bodies move in the step (sim/bodies.h)
   State step_start;              ///< the start of the step in implicit Euler's form (see Step)
   State step_geometry;           ///< BDF2: the predictor, where 𝕄 and the local drag are taken
   std::vector<BandedMatrix> jacobian;  ///< per rod
@@ -96,6 +99,7 @@ struct StepHistory {
   double previous_h = 0.0;  ///< [s]
   VecX hydro_force;         ///< the nodal drag of the last step (3M; empty without a nonlocal fluid)
   std::array<VecX, 2> earlier_drags;  ///< the drag at t_{k−1}, t_{k−2} (Workspace)
+  std::vector<BodyPose> previous_poses;  ///< the bodies at t_{k−1} (empty before the first step)
 };
 StepHistory CaptureHistory(const Workspace& ws);
 void RestoreHistory(const StepHistory& history, Workspace* ws);
