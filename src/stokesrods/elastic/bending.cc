@@ -15,53 +15,55 @@ struct MaterialPair {
   Vec3 du[2];
 };
 
-// κ = ½ (u⁰ + u¹)·κb with its gradient G and the Jacobian ∂G/∂y in y = (e0, θ0, e1, θ1), the
-// directors being carried by time-parallel transport when the edges move.
+// κ = ½ (u⁰ + u¹)·κb: its gradient G and the Jacobian ∂G/∂y in y = (e0, θ0, e1, θ1), the
+// directors being carried by time-parallel transport when the edges move. κb and J = ∂κb/∂e are
+// given (the same for both curvatures).
 //
 // Gradient. Transport moves u^j by δu^j = −(u^j·δt_j) t_j, normal to κb (κb ⊥ t0, t1), so to first
-// order the frames do not contribute:  ∂κ/∂e = ½ Jᵀ (u⁰ + u¹),  ∂κ/∂θ_j = ½ u'^j·κb,  J = ∂κb/∂e.
-//
+// order the frames do not contribute:  ∂κ/∂e = ½ Jᵀ (u⁰ + u¹),  ∂κ/∂θ_j = ½ u'^j·κb.
+Vec8 MaterialCurvatureGradient(const Vec3& kb, const Mat36& jacobian, const MaterialPair& u) {
+  Vec8 g;
+  const Vec6 grad_e = 0.5 * jacobian.transpose() * (u.u[0] + u.u[1]);
+  g.segment<3>(kEdge0) = grad_e.head<3>();
+  g.segment<3>(kEdge1) = grad_e.tail<3>();
+  g[kTheta0] = 0.5 * u.du[0].dot(kb);
+  g[kTheta1] = 0.5 * u.du[1].dot(kb);
+  return g;
+}
+
 // Jacobian of that gradient (frames transported again, as the residual of Newton is evaluated):
 //   ∂G_e/∂e   = ½ Σ_k (u⁰ + u¹)_k ∂²κb_k/∂e² − Σ_j (½/l_j) Jᵀ t_j u^jᵀ   (columns of e_j),
 //   ∂G_e/∂θ_j = ½ Jᵀ u'^j = (∂G_θj/∂e)ᵀ,   ∂G_θj/∂θ_j = −½ u^j·κb,   ∂G_θ0/∂θ1 = 0.
 // The frame term −(½/l_j) Jᵀ t_j u^jᵀ = (½/l_j) (∂t_j/∂e)ᵀ κb u^jᵀ is not symmetric (the
 // Jacobian of G is not a Hessian; see bending.h). Its symmetric part is the second derivative of κ
-// with the frames transported from the unperturbed tangents.
-EdgeDerivatives CalcMaterialCurvature(const Vec3& e0, const Vec3& e1, const MaterialPair& u) {
-  Mat36 jacobian;
-  const Vec3 kb = CalcCurvatureBinormal(e0, e1, &jacobian);
-  const Vec3 sum = u.u[0] + u.u[1];
+// with the frames transported from the unperturbed tangents. Every term is linear in the directors
+// (u, u'), so Σ_a c_a ∂G_a/∂y is this Jacobian of the directors Σ_a c_a (u_a, u'_a): one evaluation
+// serves both curvatures.
+Mat8 MaterialCurvatureJacobian(const Vec3& e0, const Vec3& e1, const Vec3& kb,
+                               const Mat36& jacobian, const MaterialPair& u) {
   const int edge_index[2] = {kEdge0, kEdge1};
   const int theta_index[2] = {kTheta0, kTheta1};
   const Vec3 edges[2] = {e0, e1};
-
-  EdgeDerivatives k;
-  k.value = 0.5 * sum.dot(kb);
-  const Vec6 grad_e = 0.5 * jacobian.transpose() * sum;
-  Mat6 jac_e = 0.5 * CalcCurvatureBinormalHessian(e0, e1, sum);
+  Mat6 jac_e = 0.5 * CalcCurvatureBinormalHessian(e0, e1, u.u[0] + u.u[1]);
   for (int j = 0; j < 2; ++j) {
     const double l = edges[j].norm();
     const Vec3 t = edges[j] / l;
     jac_e.middleCols<3>(3 * j) -= (0.5 / l) * (jacobian.transpose() * t) * u.u[j].transpose();
   }
-
-  for (int a = 0; a < 2; ++a) {
-    k.gradient.segment<3>(edge_index[a]) = grad_e.segment<3>(3 * a);
-    for (int b = 0; b < 2; ++b) {
-      k.hessian.block<3, 3>(edge_index[a], edge_index[b]) = jac_e.block<3, 3>(3 * a, 3 * b);
-    }
-  }
+  Mat8 h = Mat8::Zero();
+  for (int a = 0; a < 2; ++a)
+    for (int b = 0; b < 2; ++b)
+      h.block<3, 3>(edge_index[a], edge_index[b]) = jac_e.block<3, 3>(3 * a, 3 * b);
   for (int j = 0; j < 2; ++j) {
     const int th = theta_index[j];
-    k.gradient[th] = 0.5 * u.du[j].dot(kb);
-    k.hessian(th, th) = -0.5 * u.u[j].dot(kb);
+    h(th, th) = -0.5 * u.u[j].dot(kb);
     const Vec6 mixed = 0.5 * jacobian.transpose() * u.du[j];
     for (int a = 0; a < 2; ++a) {
-      k.hessian.block<3, 1>(edge_index[a], th) = mixed.segment<3>(3 * a);
-      k.hessian.block<1, 3>(th, edge_index[a]) = mixed.segment<3>(3 * a).transpose();
+      h.block<3, 1>(edge_index[a], th) = mixed.segment<3>(3 * a);
+      h.block<1, 3>(th, edge_index[a]) = mixed.segment<3>(3 * a).transpose();
     }
   }
-  return k;
+  return h;
 }
 
 }  // namespace
@@ -94,13 +96,22 @@ double BendingEnergy(const BendingParams& p, const Vec3& x0, const Vec3& x1, con
   if (!gradient && !hessian) return energy;
   const MaterialPair pairs[2] = {{{m2[0], m2[1]}, {-m1[0], -m1[1]}},
                                  {{-m1[0], -m1[1]}, {-m2[0], -m2[1]}}};
-  // E = ½ k Σ_a Δκ_a²:  ∇E = k Σ_a Δκ_a ∇κ_a,  ∂(∇E)/∂q = k Σ_a (∇κ_a ∇κ_aᵀ + Δκ_a ∂(∇κ_a)/∂q).
-  Vec8 g = Vec8::Zero();
-  Mat8 h = Mat8::Zero();
-  for (int a = 0; a < 2; ++a) {
-    const EdgeDerivatives k = CalcMaterialCurvature(e0, e1, pairs[a]);
-    g += p.stiffness * excess[a] * k.gradient;
-    h += p.stiffness * (k.gradient * k.gradient.transpose() + excess[a] * k.hessian);
+  // E = ½ k Σ_a Δκ_a²:  ∇E = k Σ_a Δκ_a ∇κ_a,  ∂(∇E)/∂q = k Σ_a (∇κ_a ∇κ_aᵀ + Δκ_a ∂(∇κ_a)/∂q),
+  // the last sum one Jacobian of the directors weighted by c_a = k Δκ_a (see above).
+  Mat36 jacobian;
+  CalcCurvatureBinormal(e0, e1, &jacobian);
+  const Vec8 grad[2] = {MaterialCurvatureGradient(kb, jacobian, pairs[0]),
+                        MaterialCurvatureGradient(kb, jacobian, pairs[1])};
+  const Vec8 g = p.stiffness * (excess[0] * grad[0] + excess[1] * grad[1]);
+  Mat8 h;
+  if (hessian) {
+    MaterialPair weighted;
+    for (int j = 0; j < 2; ++j) {
+      weighted.u[j] = p.stiffness * (excess[0] * pairs[0].u[j] + excess[1] * pairs[1].u[j]);
+      weighted.du[j] = p.stiffness * (excess[0] * pairs[0].du[j] + excess[1] * pairs[1].du[j]);
+    }
+    h = MaterialCurvatureJacobian(e0, e1, kb, jacobian, weighted);
+    for (int a = 0; a < 2; ++a) h.noalias() += p.stiffness * grad[a] * grad[a].transpose();
   }
   if (gradient) *gradient = EdgeToStencilGradient(g);
   if (hessian) *hessian = EdgeToStencilHessian(h);

@@ -22,9 +22,10 @@ namespace {
 // (t_i, t_i + δt_i, t_i + δt_i + dt_i), ½ t_i·(δt_i × dt_i), which the re-based gradient sees. The
 // symmetric part of the Jacobian is the second derivative of m_ref with the frames transported from
 // the unperturbed tangents; the standard DER Hessian (Bergou et al. 2010; dismech) is that part.
-EdgeDerivatives CalcReferenceTwistDerivatives(const Vec3& e0, const Vec3& e1) {
+// The Jacobian only `with_jacobian` (else left at 0).
+EdgeDerivatives CalcReferenceTwistDerivatives(const Vec3& e0, const Vec3& e1, bool with_jacobian) {
   Mat36 jacobian;
-  const Vec3 kb = CalcCurvatureBinormal(e0, e1, &jacobian);
+  const Vec3 kb = CalcCurvatureBinormal(e0, e1, with_jacobian ? &jacobian : nullptr);
   const double length[2] = {e0.norm(), e1.norm()};
   const Vec3 tangent[2] = {e0 / length[0], e1 / length[1]};
   const int edge_index[2] = {kEdge0, kEdge1};
@@ -34,6 +35,7 @@ EdgeDerivatives CalcReferenceTwistDerivatives(const Vec3& e0, const Vec3& e1) {
   for (int i = 0; i < 2; ++i) {
     const int row = edge_index[i];
     m.gradient.segment<3>(row) = kb / (2.0 * length[i]);
+    if (!with_jacobian) continue;
     for (int j = 0; j < 2; ++j) {
       jac.block<3, 3>(row, edge_index[j]) = jacobian.middleCols<3>(3 * j) / (2.0 * length[i]);
     }
@@ -53,7 +55,7 @@ double TwistingEnergy(const TwistingParams& p, const Vec3& x0, const Vec3& x1, c
   const double excess = theta1 - theta0 + reference_twist - p.rest_twist;
   const double energy = 0.5 * p.stiffness * excess * excess;
   if (!gradient && !hessian) return energy;
-  EdgeDerivatives tau = CalcReferenceTwistDerivatives(x1 - x0, x2 - x1);
+  EdgeDerivatives tau = CalcReferenceTwistDerivatives(x1 - x0, x2 - x1, hessian != nullptr);
   tau.gradient[kTheta0] = -1.0;
   tau.gradient[kTheta1] = 1.0;
   if (gradient) *gradient = EdgeToStencilGradient(p.stiffness * excess * tau.gradient);

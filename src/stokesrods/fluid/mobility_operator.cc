@@ -141,6 +141,8 @@ class MatrixFreeRssMobility final : public MobilityOperator {
   // k ∈ [near_start_[t], near_start_[t + 1]).
   std::vector<int> near_start_, near_source_;
   std::vector<Mat3> near_block_;
+  // FindNearPairs' blocks per target before they are packed (kept: their capacity is reused).
+  std::vector<std::vector<std::pair<int, Mat3>>> per_target_;
   mutable Matrix3X strengths_, far_velocity_;
 };
 
@@ -229,7 +231,8 @@ void MatrixFreeRssMobility::FindNearPairs(const Matrix3X& targets) {
                          accuracy_, split_.gauss_points);
   const double scale = 1.0 / (8.0 * kPi * params_.viscosity);
   const int m = static_cast<int>(targets.cols());
-  std::vector<std::vector<std::pair<int, Mat3>>> per_target(static_cast<size_t>(m));
+  std::vector<std::vector<std::pair<int, Mat3>>>& per_target = per_target_;
+  per_target.resize(static_cast<size_t>(m));
 #pragma omp parallel
   {
     std::vector<int> near;          // global segment indices near the target, in rod order
@@ -256,6 +259,7 @@ void MatrixFreeRssMobility::FindNearPairs(const Matrix3X& targets) {
         }
       }
       std::vector<std::pair<int, Mat3>>& blocks = per_target[static_cast<size_t>(t)];
+      blocks.clear();
       for (std::size_t i = 0; i < near.size();) {  // one rod at a time (segments in rod order)
         const int rod = segments_[static_cast<size_t>(near[i])].rod;
         const int rod_first_segment = node_offset(rod) - rod;  // N_k − 1 segments per rod

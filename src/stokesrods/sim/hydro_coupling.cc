@@ -320,7 +320,9 @@ void HydroCoupling::Precondition(const VecX& v, VecX* out) const {
   Gemv(coarse_w_, coarse.cast<float>(), &wc);
   const VecX rest = v - wc.cast<double>();
   out->resize(v.size());
-  for (int r = 0; r < mobility_->num_rods(); ++r) {
+  const int num_rods = mobility_->num_rods();
+#pragma omp parallel for schedule(static) if (num_rods > 1)
+  for (int r = 0; r < num_rods; ++r) {
     const int first = 3 * mobility_->node_offset(r);
     const int n = 3 * (mobility_->node_offset(r + 1) - mobility_->node_offset(r));
     Eigen::VectorXf x = rest.segment(first, n).cast<float>();
