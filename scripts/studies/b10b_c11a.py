@@ -56,7 +56,7 @@ def plot():
     bdf2 = line(read("b10_cases.csv"), "nodes", "65")
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     panels = ((axes[0], read("b10b_cases.csv"), "B.10(b): RSS, N = 65, ε = 1.02 r0", 675, "paper ω̄_b = 675"),
-              (axes[1], read("c11a_cases.csv"), "C.11(a): to t̄ = 1", 660, "paper LSBT ω̄_b = 660"))
+              (axes[1], read("c11a_cases.csv"), "C.11(a): BDF2, h = 20 ms, to t̄ = 1", 660, "paper LSBT ω̄_b = 660"))
     for ax, rows, title, paper, paper_label in panels:
         for (label, marker) in zip(sorted({r["run"] for r in rows}), ("o-", "s--", "v-.")):
             pts = line(rows, "run", label)
