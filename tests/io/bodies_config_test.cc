@@ -66,6 +66,8 @@ TEST(BodiesConfig, BadBodiesAndWallsAreRefusedNamingTheKey) {
   ExpectError(base + "[[bodies]]\nvelocity = [1.0, 0.0, 0.0]\n",
               "bodies.1.velocity: only for motion = \"prescribed\"");
   ExpectError(base + "[[bodies]]\ncolour = 1\n", "bodies.1.colour: unknown key");
+  ExpectError(base + body + "force = [0.0, 0.0, -1.0]\n", "bodies.1.force: only for motion = \"free\"");
+  ExpectError(base + body + "motion = \"free\"\ntorque = [0.0, 0.0, inf]\n", "bodies.1.torque: must be finite");
   ExpectError(base + body + "surface_points = 3\n", "bodies.1.surface_points: must be between 20");
   ExpectError(base + "[fluid]\nmodel = \"lsbt\"\n" + body, "bodies.1: bodies need fluid.model = \"rss\"");
   ExpectError(base + "[fluid]\nmobility = \"matrix_free\"\n" + body, "fluid.mobility: \"matrix_free\" does not take bodies");

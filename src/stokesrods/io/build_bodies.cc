@@ -95,6 +95,8 @@ void AddBodies(const Config& config, Model* model) {
                                             : BodyMotion::kFixed;
     body.velocity = bc.velocity;
     body.angular_velocity = bc.angular_velocity;
+    body.force = bc.force;
+    body.torque = bc.torque;
     const BodySurface surface =
         SphereSurface(Vec3::Zero(), bc.radius, bc.surface_points, kBodyBlobOverSpacing);
     body.surface = surface.points;

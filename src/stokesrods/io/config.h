@@ -125,6 +125,8 @@ struct BodyConfig {
   std::string motion = "fixed";            ///< "free" | "fixed" | "prescribed"
   Vec3 velocity = Vec3::Zero();            ///< [m/s], "prescribed" only
   Vec3 angular_velocity = Vec3::Zero();    ///< [rad/s] about the centre, "prescribed" only
+  Vec3 force = Vec3::Zero();               ///< a constant load on the body [N], "free" only
+  Vec3 torque = Vec3::Zero();              ///< a constant torque about its centre [N·m], "free" only
   int surface_points = 400;                ///< regularized Stokeslets on the surface
 };
 

@@ -24,6 +24,8 @@ void ValidateBody(const Config& config, const std::string& p, const BodyConfig& 
   CheckFinite(file, p + ".center", body.center);
   CheckFinite(file, p + ".velocity", body.velocity);
   CheckFinite(file, p + ".angular_velocity", body.angular_velocity);
+  CheckFinite(file, p + ".force", body.force);
+  CheckFinite(file, p + ".torque", body.torque);
   static const std::set<std::string> kMotions = {"fixed", "free", "prescribed"};
   if (kMotions.count(body.motion) == 0)
     throw ConfigError(file, p + ".motion",
@@ -31,6 +33,9 @@ void ValidateBody(const Config& config, const std::string& p, const BodyConfig& 
   if (body.motion != "prescribed" && (body.velocity != Vec3::Zero() || body.angular_velocity != Vec3::Zero()))
     throw ConfigError(file, p + (body.velocity != Vec3::Zero() ? ".velocity" : ".angular_velocity"),
                       "only for motion = \"prescribed\"");
+  if (body.motion != "free" && (body.force != Vec3::Zero() || body.torque != Vec3::Zero()))
+    throw ConfigError(file, p + (body.force != Vec3::Zero() ? ".force" : ".torque"),
+                      "only for motion = \"free\" (fixed and prescribed bodies take any load)");
   if (body.surface_points < 20 || body.surface_points > 20000)
     throw ConfigError(file, p + ".surface_points",
                       fmt::format("must be between 20 and 20000 (got {})", body.surface_points));

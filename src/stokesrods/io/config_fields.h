@@ -96,6 +96,8 @@ void VisitFields(BodyConfig& c, V& v) {
   v("motion", c.motion);
   v("velocity", c.velocity);
   v("angular_velocity", c.angular_velocity);
+  v("force", c.force);
+  v("torque", c.torque);
   v("surface_points", c.surface_points);
 }
 template <class V>

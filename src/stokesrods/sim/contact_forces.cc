@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "stokesrods/contact/contact_response.h"
+#include "stokesrods/sim/body_contact.h"
 #include "stokesrods/sim/obstacle_contact.h"
 #include "stokesrods/sim/state.h"
 
@@ -17,11 +18,15 @@ std::string DescribeDeepest(const ContactSummary& summary) {
     return fmt::format("rod {}, segment {} (nodes {}-{})", s.rod + 1, s.index, s.index,
                        s.index + 1);
   };
+  auto obstacle = [&] {
+    return summary.obstacle_body < 0 ? std::string("the wall")
+                                     : fmt::format("body {}", summary.obstacle_body + 1);
+  };
+  if (summary.deepest_body >= 0)
+    return fmt::format("body {} against {}", summary.deepest_body + 1, obstacle());
   if (summary.obstacle_node >= 0)
     return fmt::format("rod {}, node {} against {}", summary.deepest.a.rod + 1,
-                       summary.obstacle_node,
-                       summary.obstacle_body < 0 ? std::string("the wall")
-                                                 : fmt::format("body {}", summary.obstacle_body + 1));
+                       summary.obstacle_node, obstacle());
   return segment(summary.deepest.a) + " against " + segment(summary.deepest.b);
 }
 
@@ -137,26 +142,48 @@ VecX SolveMultipliers(const MatX& w, const VecX& eps) {
 
 }  // namespace
 
+namespace {
+
+// The obstacles' and the bodies' pairs into the summary (the rods' are in already).
+void SummarizeOthers(const Model& model, const std::vector<ObstaclePair>& obstacles,
+                     const std::vector<BodyPair>& bodies, ContactSummary* summary) {
+  auto count = [&](double penetration, double contact_distance) {
+    ++summary->detected;
+    const bool deepest = penetration >= summary->max_penetration;
+    summary->max_penetration = std::max(summary->max_penetration, penetration);
+    if (penetration > model.newton.contact_tolerance * contact_distance) ++summary->active;
+    if (deepest) summary->deepest_contact_distance = contact_distance;
+    return deepest;
+  };
+  for (const ObstaclePair& o : obstacles)
+    if (count(o.penetration, model.rods[o.rod].radius)) {
+      summary->deepest = SegmentPair{{o.rod, o.node}, {o.rod, o.node}};
+      summary->obstacle_node = o.node;
+      summary->obstacle_body = o.body;
+      summary->deepest_body = -1;
+    }
+  for (const BodyPair& b : bodies)
+    if (count(b.penetration, b.contact_distance)) {
+      summary->deepest_body = b.body;
+      summary->obstacle_body = b.other;
+      summary->obstacle_node = -1;
+    }
+}
+
+}  // namespace
+
 ContactSummary AddContactForces(const Model& model, const VecX& q, double h,
                                 const LinearResponse& respond, VecX* contact_force,
                                 const std::vector<BodyPose>& poses, VecX* body_loads) {
   const ContactInput in = MakeInput(model, q);
   const std::vector<ContactPair> pairs = DetectContacts(in.rods, in.radii, in.self_exclusion);
   ContactSummary summary = Summarize(model, pairs);
+  const bool have_poses = poses.size() == model.bodies.size();
   const std::vector<ObstaclePair> obstacles =
-      poses.size() == model.bodies.size() ? DetectObstacleContacts(model, q, poses)
-                                          : std::vector<ObstaclePair>();
-  for (const ObstaclePair& o : obstacles) {
-    ++summary.detected;
-    if (o.penetration >= summary.max_penetration) {
-      summary.deepest = SegmentPair{{o.rod, o.node}, {o.rod, o.node}};
-      summary.obstacle_node = o.node;
-      summary.obstacle_body = o.body;
-      summary.deepest_contact_distance = model.rods[o.rod].radius;
-    }
-    summary.max_penetration = std::max(summary.max_penetration, o.penetration);
-    if (o.penetration > model.newton.contact_tolerance * model.rods[o.rod].radius) ++summary.active;
-  }
+      have_poses ? DetectObstacleContacts(model, q, poses) : std::vector<ObstaclePair>();
+  const std::vector<BodyPair> bodies =
+      have_poses ? DetectBodyContacts(model, poses) : std::vector<BodyPair>();
+  SummarizeOthers(model, obstacles, bodies, &summary);
   if (summary.active == 0) return summary;
 
   // Clamped nodes have zero inverse mass: they never move, the other side takes it all.
@@ -170,47 +197,59 @@ ContactSummary AddContactForces(const Model& model, const VecX& q, double h,
     }
     inverse_masses.push_back(std::move(w));
   }
-  // Per pair: its eq. 19–20 force F_k and the response of every pair's separation to it.
-  // The rods' pairs first, then the obstacles' (obstacle_contact.h: the node alone moves).
-  const Eigen::Index pr = static_cast<Eigen::Index>(pairs.size());
-  const Eigen::Index p = pr + static_cast<Eigen::Index>(obstacles.size());
+  // Per pair: its trial force F_k on the rods (eq. 19–20) and loads L_k on the free bodies, and
+  // the response of every pair's separation to them. The rods' pairs first, then the obstacles'
+  // (obstacle_contact.h: the node moves, and a free body with its reaction), then the bodies'.
+  const auto pr = static_cast<Eigen::Index>(pairs.size());
+  const auto po = pr + static_cast<Eigen::Index>(obstacles.size());
+  const Eigen::Index p = po + static_cast<Eigen::Index>(bodies.size());
+  const int loads_size = 6 * model.num_free_bodies;
   std::vector<VecX> forces(static_cast<std::size_t>(p), VecX::Zero(model.num_dofs));
+  std::vector<VecX> loads(static_cast<std::size_t>(p), VecX::Zero(loads_size));
+  auto obstacle = [&](Eigen::Index k) -> const ObstaclePair& { return obstacles[static_cast<std::size_t>(k - pr)]; };
+  auto body_pair = [&](Eigen::Index k) -> const BodyPair& { return bodies[static_cast<std::size_t>(k - po)]; };
   auto node_dof = [&](const ObstaclePair& o) { return model.rods[o.rod].dof_offset + NodeDof(o.node); };
   MatX w(p, p);
-  VecX eps(p), dq;
+  VecX eps(p), dq, dv = VecX::Zero(loads_size);
   for (Eigen::Index k = 0; k < p; ++k) {
+    const auto kk = static_cast<std::size_t>(k);
     if (k < pr) {
-      const std::vector<Matrix3X> dx = CalcContactDisplacements({pairs[k]}, inverse_masses);
+      const std::vector<Matrix3X> dx = CalcContactDisplacements({pairs[kk]}, inverse_masses);
       for (std::size_t r = 0; r < model.rods.size(); ++r) {
         const RodModel& rod = model.rods[r];
         for (int i = 0; i < rod.num_nodes(); ++i)
-          forces[k].segment<3>(rod.dof_offset + NodeDof(i)) =
+          forces[kk].segment<3>(rod.dof_offset + NodeDof(i)) =
               rod.mass(NodeDof(i)) * dx[r].col(i) / (h * h);
       }
-      eps(k) = pairs[k].penetration;
-    } else {
-      const ObstaclePair& o = obstacles[static_cast<std::size_t>(k - pr)];
-      forces[k].segment<3>(node_dof(o)) =
-          model.rods[o.rod].mass(NodeDof(o.node)) * o.penetration * o.normal / (h * h);
+      eps(k) = pairs[kk].penetration;
+    } else if (k < po) {
+      const ObstaclePair& o = obstacle(k);
+      const Vec3 f = model.rods[o.rod].mass(NodeDof(o.node)) * o.penetration * o.normal / (h * h);
+      forces[kk].segment<3>(node_dof(o)) = f;
+      AddObstacleReaction(model, o, f, poses, &loads[kk]);
       eps(k) = o.penetration;
+    } else {
+      const BodyPair& b = body_pair(k);
+      AddBodyPairLoads(model, b, BodyPairTrialForce(model, b, h), poses, &loads[kk]);
+      eps(k) = b.penetration;
     }
-    respond(forces[k], &dq);
+    respond(forces[kk], loads[kk], &dq, &dv);
     for (Eigen::Index j = 0; j < p; ++j) {
       if (j < pr) {
-        w(j, k) = SeparationChange(model, pairs[j], dq);
+        w(j, k) = SeparationChange(model, pairs[static_cast<std::size_t>(j)], dq);
+      } else if (j < po) {
+        const ObstaclePair& o = obstacle(j);
+        w(j, k) = o.normal.dot(dq.segment<3>(node_dof(o)) -
+                               BodyPointShift(model, o.body, poses, o.point, h, dv));
       } else {
-        const ObstaclePair& o = obstacles[static_cast<std::size_t>(j - pr)];
-        w(j, k) = o.normal.dot(dq.segment<3>(node_dof(o)));
+        w(j, k) = BodyPairSeparationChange(model, body_pair(j), poses, h, dv);
       }
     }
   }
   const VecX lambda = SolveMultipliers(w, eps);
   for (Eigen::Index k = 0; k < p; ++k) {
-    *contact_force += lambda(k) * forces[k];
-    if (k >= pr && body_loads) {
-      const ObstaclePair& o = obstacles[static_cast<std::size_t>(k - pr)];
-      AddObstacleReaction(model, o, lambda(k) * forces[k].segment<3>(node_dof(o)), poses, body_loads);
-    }
+    *contact_force += lambda(k) * forces[static_cast<std::size_t>(k)];
+    if (body_loads && loads_size > 0) *body_loads += lambda(k) * loads[static_cast<std::size_t>(k)];
   }
   return summary;
 }

@@ -30,11 +30,12 @@ struct ContactSummary {
   SegmentPair deepest;
   int obstacle_node = -1;
   int obstacle_body = -1;
+  int deepest_body = -1;  ///< when ≥ 0: body deepest_body against obstacle_body (−1: the wall)
   double deepest_contact_distance = 0.0;  ///< r_a + r_b, or r0 against an obstacle [m]
 };
 
-/// "rod 1, segment 14 (nodes 14-15) against rod 2, segment 9 (nodes 9-10)" or "rod 1, node 3
-/// against the wall" (rods and bodies from 1, nodes from 0).
+/// "rod 1, segment 14 (nodes 14-15) against rod 2, segment 9 (nodes 9-10)", "rod 1, node 3
+/// against the wall" or "body 1 against body 2" (rods and bodies from 1, nodes from 0).
 std::string DescribeDeepest(const ContactSummary& summary);
 
 /// Segments of one rod closer than this many indices apart are never in contact with each other.
@@ -48,8 +49,11 @@ ContactSummary MeasureContacts(const Model& model, const VecX& q);
 /// (∞ with a single rod).
 double MinDistanceBetweenRods(const Model& model, const VecX& q);
 
-/// The linear response of the step to an extra force: dq = J⁻¹ F (J the Newton matrix).
-using LinearResponse = std::function<void(const VecX& force, VecX* dq)>;
+/// The linear response of the step to an extra force F on the rods' DOFs and loads L on the free
+/// bodies (force and torque about the centre, 6 each; empty without free bodies): the change dq
+/// of q and dv of the free bodies' (U, Ω) (6 each) that J (the Newton matrix) gives them.
+using LinearResponse =
+    std::function<void(const VecX& force, const VecX& body_load, VecX* dq, VecX* dv)>;
 
 /// Detects the pairs closer than the contact distance at q. If any penetrates by more than the
 /// tolerance (model.newton.contact_tolerance × contact distance), adds contact forces for all
@@ -61,8 +65,10 @@ using LinearResponse = std::function<void(const VecX& force, VecX* dq)>;
 /// when the rod's stiffness or drag dominate, eq. 20 alone would close only a fraction
 /// m/(h² J) of the gap per round. Returns what it found before the correction (active = 0 means
 /// resolved).
-/// The rods' contacts with the wall and the bodies at `poses` (obstacle_contact.h) join the same
-/// multipliers; their reactions on free bodies accumulate in `body_loads` (6 per free body).
+/// The rods' contacts with the wall and the bodies at `poses` (obstacle_contact.h) and the bodies'
+/// with each other and the wall (body_contact.h) join the same multipliers, W including the free
+/// bodies' motion under each pair's loads; those loads accumulate in `body_loads` (6 per free
+/// body).
 ContactSummary AddContactForces(const Model& model, const VecX& q, double h,
                                 const LinearResponse& respond, VecX* contact_force,
                                 const std::vector<BodyPose>& poses = {},

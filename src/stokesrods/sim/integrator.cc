@@ -280,7 +280,7 @@ NewtonReport SolveNewton(const Model& model, const State& start, double h, Works
   auto no_slip_residual = [&](const VecX& q, const VecX& f, VecX* r_u) {
     ws->hydro.VelocityResidual(model, q, start.q, h, f, r_u);
     if (ws->free_clamps) r_u->tail(ws->clamp_loads.size()) -= ws->clamp_loads;
-    if (model.num_free_bodies > 0) r_u->tail(ws->body_contact_load.size()) += ws->body_contact_load;
+    if (model.num_free_bodies > 0) r_u->tail(ws->body_load.size()) += ws->body_load;
   };
   if (saddle) no_slip_residual(ws->q, ws->hydro_force, &ws->velocity_residual);
   auto norm_of = [&](const VecX& r, const VecX& r_u) {
@@ -387,7 +387,9 @@ void PrepareStep(const Model& model, const State& start, Workspace* ws) {
     if (model.coupling == FluidCoupling::kExplicit) ws->hydro_force = ws->hydro.explicit_force();
   }
   ws->contact_force.setZero();
-  ws->body_contact_load.setZero(6 * model.num_free_bodies);
+  ws->body_load.setZero(6 * model.num_free_bodies);  // the bodies' own loads, then contacts'
+  for (const BodyModel& body : model.bodies)
+    if (body.free_index >= 0) ws->body_load.segment<6>(6 * body.free_index) << body.force, body.torque;
   ws->load_factor = 1.0;
 }
 
@@ -490,15 +492,19 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
       ws->factors_h = he;
       ws->factors_age = 0;
     }
-    const VecX no_slip = VecX::Zero(ws->nonlocal_fluid ? model.hydro_size() : 0);
-    const LinearResponse respond = [&](const VecX& force, VecX* dq) {
-      VecX df, du;  // −J⁻¹(−F) = J⁻¹ F, the drag responding with the rods
-      report.krylov_iterations += NewtonCorrection(model, he, -force, no_slip, ws, dq, &df, &du);
+    // The rods' DOFs take F as −F in r_q, the free bodies' rows L as +L in r_u: the response is
+    // the Newton correction of those increments, the drag and (U, Ω) responding with the rods.
+    const LinearResponse respond = [&](const VecX& force, const VecX& body_load, VecX* dq,
+                                       VecX* dv) {
+      VecX r_u = VecX::Zero(ws->nonlocal_fluid ? model.hydro_size() : 0), df, du;
+      r_u.tail(body_load.size()) = body_load;
+      report.krylov_iterations += NewtonCorrection(model, he, -force, r_u, ws, dq, &df, &du);
+      *dv = df.tail(body_load.size());
     };
     std::vector<BodyPose> poses;  // at the step's end, with the current V
     if (!model.bodies.empty()) EndPoses(model, ws->body_step, ws->hydro_force, &poses);
     report.contact = AddContactForces(model, ws->q, he, respond, &ws->contact_force, poses,
-                                      &ws->body_contact_load);
+                                      &ws->body_load);
     if (report.contact.active == 0) break;  // report.contact describes the final state
     report.contact_pairs = std::max(report.contact_pairs, report.contact.detected);
     if (report.contact_rounds >= model.newton.max_contact_rounds) {

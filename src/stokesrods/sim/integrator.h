@@ -70,7 +70,9 @@ struct Workspace {
   VecX force;                    ///< F_int + F_ext + F^h + F^c at q (after a converged solve)
   VecX residual, residual_try, delta, simplified;
   VecX contact_force;            ///< F^c, constant during a Newton solve
-  VecX body_contact_load;        ///< its reactions on the free bodies (6 each), as constant
+  /// The loads on the free bodies (force, torque about the centre; 6 each), constant in a Newton
+  /// solve: their own (BodyModel::force, torque) and the contacts' reactions.
+  VecX body_load;
   VecX previous_velocity;        ///< q̇(t_{k−1}), for the second-order predictor and BDF2
   VecX previous_q;               ///< q(t_{k−1}), for BDF2
   double previous_h = 0.0;       ///< the step that led to t_k

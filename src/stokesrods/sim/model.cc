@@ -74,12 +74,14 @@ void FinalizeLayout(Model* model) {
     body.point_offset = points;
     body.free_index = body.motion == BodyMotion::kFree ? model->num_free_bodies++ : -1;
     points += body.num_points();
-    // Without rods the bodies set the scales: their size and their Stokes drag.
+    // Without rods the bodies set the scales: their size and their Stokes drag or own load.
     if (!model->rods.empty()) continue;
     model->length_scale = std::max(model->length_scale, 2.0 * body.radius);
     model->max_voronoi_length = std::max(model->max_voronoi_length, body.regularization);
-    model->force_scale = std::max(model->force_scale, 6.0 * kPi * model->fluid.viscosity * body.radius *
-                                                          (body.velocity.norm() + body.radius * body.angular_velocity.norm()));
+    model->force_scale = std::max({model->force_scale,
+                                   6.0 * kPi * model->fluid.viscosity * body.radius *
+                                       (body.velocity.norm() + body.radius * body.angular_velocity.norm()),
+                                   body.force.norm() + body.torque.norm() / body.radius});
   }
   model->num_body_points = points;
 }

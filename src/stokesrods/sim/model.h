@@ -75,6 +75,8 @@ struct BodyModel {
   BodyMotion motion = BodyMotion::kFixed;
   Vec3 velocity = Vec3::Zero();            ///< U [m/s]
   Vec3 angular_velocity = Vec3::Zero();    ///< Ω about the centre [rad/s]
+  Vec3 force = Vec3::Zero();               ///< a free body's own load (e.g. weight − buoyancy) [N]
+  Vec3 torque = Vec3::Zero();              ///< and torque about its centre [N·m]
   Matrix3X surface;                        ///< surface points relative to the centre at t = 0 [m]
   double regularization = 0.0;             ///< ε of the surface blobs [m]
   int point_offset = 0;                    ///< first of its points after all rods' nodes
