@@ -13,6 +13,7 @@
 
 #include <Eigen/Geometry>
 
+#include "common/product_error.h"
 #include "stokesrods/fluid/rss.h"
 #include "stokesrods/rod/geometry.h"
 
@@ -20,7 +21,7 @@ namespace stokesrods {
 namespace {
 
 // max over random forces of |𝕄_mf F − 𝕄 F|_∞ / |𝕄 F|_∞.
-double WorstProductError(const std::vector<HydroRod>& rods, const MobilityOptions& options) {
+double WorstRodsProductError(const std::vector<HydroRod>& rods, const MobilityOptions& options) {
   FluidParams exact;  // round-off
   MatX dense;
   AssembleRssMobility(exact, rods, &dense);
@@ -28,19 +29,7 @@ double WorstProductError(const std::vector<HydroRod>& rods, const MobilityOption
   params.far_field_tolerance = options.tolerance;
   const auto op = MakeMobilityOperator(params, options);
   op->Update(rods);
-  std::mt19937 rng(7);
-  std::normal_distribution<double> normal;
-  double worst = 0.0;
-  for (int trial = 0; trial < 4; ++trial) {
-    VecX f(dense.cols());
-    for (Eigen::Index i = 0; i < f.size(); ++i) f(i) = normal(rng);
-    VecX u;
-    op->Apply(f, &u);
-    const VecX reference = dense * f;
-    worst = std::max(worst, (u - reference).lpNorm<Eigen::Infinity>() /
-                                reference.lpNorm<Eigen::Infinity>());
-  }
-  return worst;
+  return WorstProductError(*op, dense, 7);
 }
 
 struct Geometry {
@@ -82,12 +71,8 @@ TEST(MatrixFreeMobility, MatchesTheDenseOperatorWithTheDirectSum) {
   const Geometry g = CloseRods();
   const MobilityOptions defaults;
   for (const double tolerance : {1e-8, 1e-5, defaults.fast_sum_tolerance}) {
-    MobilityOptions options;
-    options.kind = MobilityKind::kMatrixFree;
-    options.fast_sum_tolerance = tolerance;
-    options.tolerance = std::min(tolerance, defaults.tolerance);
-    options.direct_sum_below = 1e12;  // never the FMM
-    const double error = WorstProductError(g.Rods(), options);
+    const MobilityOptions options = DirectSumOptions(tolerance);
+    const double error = WorstRodsProductError(g.Rods(), options);
     std::printf("  direct far sum, tolerance %.0e: product error %.2e\n", tolerance, error);
     EXPECT_LT(error, 10.0 * tolerance);
   }
@@ -102,7 +87,7 @@ TEST(MatrixFreeMobility, MatchesTheDenseOperatorWithTheFmm) {
   options.kind = MobilityKind::kMatrixFree;
   options.direct_sum_below = 0.0;
   options.fast_sum_by_cost = false;
-  const double error = WorstProductError(g.Rods(), options);
+  const double error = WorstRodsProductError(g.Rods(), options);
   std::printf("  FMM far sum (p = 4): product error %.2e\n", error);
   EXPECT_LT(error, 1e-3);
 }
