@@ -67,6 +67,15 @@ TEST(BodiesConfig, BadBodiesAndWallsAreRefusedNamingTheKey) {
               "bodies.1.velocity: only for motion = \"prescribed\"");
   ExpectError(base + "[[bodies]]\ncolour = 1\n", "bodies.1.colour: unknown key");
   ExpectError(base + body + "force = [0.0, 0.0, -1.0]\n", "bodies.1.force: only for motion = \"free\"");
+  ExpectError(base + body + "half_length = 0.02\n", "bodies.1.half_length: only for shape = \"spheroid\"");
+  const std::string spheroid = body + "shape = \"spheroid\"\nhalf_length = 0.02\n";
+  ExpectError(base + spheroid, "bodies.1.shape: a \"spheroid\" takes no contact yet");
+  ExpectError(base + "[contact]\nenabled = false\n" + body + "shape = \"spheroid\"\n",
+              "bodies.1.half_length: a spheroid needs a finite polar semi-axis > 0");
+  ExpectError(base + "[contact]\nenabled = false\n" + spheroid + "axis = [0.0, 0.0, 0.0]\n",
+              "bodies.1.axis: must not be the zero vector");
+  ExpectError(std::string(kRun) + "[contact]\nenabled = false\n" + kRod + "body = 1\n" + spheroid,
+              "rods.1.body: body 1 is a spheroid: rods are clamped on spheres only yet");
   ExpectError(base + body + "motion = \"free\"\ntorque = [0.0, 0.0, inf]\n", "bodies.1.torque: must be finite");
   ExpectError(base + body + "surface_points = 3\n", "bodies.1.surface_points: must be between 20");
   ExpectError(base + "[fluid]\nmodel = \"lsbt\"\n" + body, "bodies.1: bodies need fluid.model = \"rss\"");

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 
 #include "stokesrods/common/assert.h"
@@ -28,6 +29,30 @@ BodySurface SphereSurface(const Vec3& center, double radius, int n, double blob_
   BodySurface s;
   s.points = (radius * FibonacciSphere(n)).colwise() + center;
   s.regularization = blob_over_spacing * std::sqrt(4.0 * kPi * radius * radius / n);
+  return s;
+}
+
+BodySurface SpheroidSurface(const Vec3& center, double radius, double half_length, const Vec3& axis,
+                            int n, double blob_over_spacing) {
+  SR_ASSERT(radius > 0.0 && half_length > 0.0 && axis.norm() > 0.0, "spheroid: bad semi-axes or axis");
+  const double b = radius, a = half_length;
+  double area = 4.0 * kPi * b * b;  // a sphere
+  if (a > b) {         // prolate: 2πb²(1 + a/(b e) asin e), e² = 1 − b²/a²
+    const double e = std::sqrt(1.0 - b * b / (a * a));
+    area = 2.0 * kPi * b * b * (1.0 + a / (b * e) * std::asin(e));
+  } else if (a < b) {  // oblate: 2πb²(1 + (1 − e²)/e atanh e), e² = 1 − a²/b²
+    const double e = std::sqrt(1.0 - a * a / (b * b));
+    area = 2.0 * kPi * b * b * (1.0 + (1.0 - e * e) / e * std::atanh(e));
+  }
+  Matrix3X unit = FibonacciSphere(n);
+  unit.row(0) *= b;
+  unit.row(1) *= b;
+  unit.row(2) *= a;
+  const Mat3 turn = Eigen::Quaterniond::FromTwoVectors(Vec3::UnitZ(), axis.normalized()).toRotationMatrix();
+  BodySurface s;
+  s.points = (turn * unit).colwise() + center;
+  s.regularization = blob_over_spacing * std::sqrt(area / n);
+  s.center = center;
   return s;
 }
 

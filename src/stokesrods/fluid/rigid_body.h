@@ -34,6 +34,12 @@ Matrix3X FibonacciSphere(int n);
 /// A sphere of `radius` [m] about `center` with N points and ε = blob_over_spacing · √(4πa²/N).
 BodySurface SphereSurface(const Vec3& center, double radius, int n, double blob_over_spacing);
 
+/// A spheroid about `center`: equatorial radius b = `radius`, polar semi-axis a = `half_length` along
+/// the unit `axis` (prolate a > b, oblate a < b), N points (the Fibonacci sphere stretched by (b, b, a)
+/// and turned from z to the axis; no longer equal-area), ε = blob_over_spacing · √(area/N).
+BodySurface SpheroidSurface(const Vec3& center, double radius, double half_length, const Vec3& axis,
+                            int n, double blob_over_spacing);
+
 /// 𝕄 (3N × 3N) of the points: U = 𝕄 F with the regularized Stokeslets above [m/(N·s)]; with a
 /// `wall`, the Stokeslets and their images (wall.h).
 MatX PointStokesletMobility(const BodySurface& surface, double viscosity,

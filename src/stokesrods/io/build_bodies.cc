@@ -88,7 +88,8 @@ void CheckBodiesAndWall(const Config& config, const Model& model) {
 void AddBodies(const Config& config, Model* model) {
   for (const BodyConfig& bc : config.bodies) {
     BodyModel body;
-    body.radius = bc.radius;
+    // A spheroid's scales and the start's overlap checks take its largest semi-axis (conservative).
+    body.radius = bc.shape == "spheroid" ? std::max(bc.radius, bc.half_length) : bc.radius;
     body.center = bc.center;
     body.motion = bc.motion == "prescribed" ? BodyMotion::kPrescribed
                   : bc.motion == "free"     ? BodyMotion::kFree
@@ -98,7 +99,10 @@ void AddBodies(const Config& config, Model* model) {
     body.force = bc.force;
     body.torque = bc.torque;
     const BodySurface surface =
-        SphereSurface(Vec3::Zero(), bc.radius, bc.surface_points, kBodyBlobOverSpacing);
+        bc.shape == "spheroid"
+            ? SpheroidSurface(Vec3::Zero(), bc.radius, bc.half_length, bc.axis, bc.surface_points,
+                              kBodyBlobOverSpacing)
+            : SphereSurface(Vec3::Zero(), bc.radius, bc.surface_points, kBodyBlobOverSpacing);
     body.surface = surface.points;
     body.regularization = surface.regularization;
     model->bodies.push_back(std::move(body));

@@ -119,8 +119,10 @@ struct RodConfig {
 
 /// A rigid cell body (SPEC "Additions"): its surface as regularized Stokeslets (fluid/rigid_body.h).
 struct BodyConfig {
-  std::string shape = "sphere";            ///< "sphere"
-  double radius = 0.02;                    ///< a [m]
+  std::string shape = "sphere";            ///< "sphere" | "spheroid"
+  double radius = 0.02;                    ///< a [m]; a spheroid's equatorial radius b
+  double half_length = 0.0;                ///< a spheroid's polar semi-axis [m]
+  Vec3 axis = Vec3::UnitZ();               ///< a spheroid's axis at the start (normalized when read)
   Vec3 center = Vec3::Zero();              ///< [m]
   std::string motion = "fixed";            ///< "free" | "fixed" | "prescribed"
   Vec3 velocity = Vec3::Zero();            ///< [m/s], "prescribed" only

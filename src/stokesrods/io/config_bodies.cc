@@ -15,10 +15,36 @@ void CheckFinite(const std::string& file, const std::string& key, const Vec3& v)
   if (!v.allFinite()) throw ConfigError(file, key, "must be finite");
 }
 
+// A spheroid: its semi-axis and axis; no contact and no rods on it yet (both assume a sphere).
+void ValidateSpheroid(const Config& config, const std::string& p, int k, BodyConfig* body) {
+  const std::string& file = config.file;
+  if (body->shape == "sphere") {
+    if (body->half_length != 0.0 || body->axis != Vec3::UnitZ())
+      throw ConfigError(file, p + (body->half_length != 0.0 ? ".half_length" : ".axis"),
+                        "only for shape = \"spheroid\"");
+    return;
+  }
+  if (!(body->half_length > 0.0) || !std::isfinite(body->half_length))
+    throw ConfigError(file, p + ".half_length",
+                      fmt::format("a spheroid needs a finite polar semi-axis > 0 (got {})", body->half_length));
+  CheckFinite(file, p + ".axis", body->axis);
+  if (!(body->axis.norm() > 0.0)) throw ConfigError(file, p + ".axis", "must not be the zero vector");
+  body->axis.normalize();
+  if (config.contact.enabled)
+    throw ConfigError(file, p + ".shape",
+                      "a \"spheroid\" takes no contact yet (contact assumes spheres); set "
+                      "contact.enabled = false");
+  for (std::size_t r = 0; r < config.rods.size(); ++r)
+    if (config.rods[r].body == k + 1)
+      throw ConfigError(file, fmt::format("rods.{}.body", r + 1),
+                        fmt::format("body {} is a spheroid: rods are clamped on spheres only yet", k + 1));
+}
+
 void ValidateBody(const Config& config, const std::string& p, const BodyConfig& body) {
   const std::string& file = config.file;
-  if (body.shape != "sphere")
-    throw ConfigError(file, p + ".shape", fmt::format("\"{}\" is not one of \"sphere\"", body.shape));
+  if (body.shape != "sphere" && body.shape != "spheroid")
+    throw ConfigError(file, p + ".shape",
+                      fmt::format("\"{}\" is not one of \"sphere\", \"spheroid\"", body.shape));
   if (!(body.radius > 0.0) || !std::isfinite(body.radius))
     throw ConfigError(file, p + ".radius", fmt::format("must be a finite number > 0 (got {})", body.radius));
   CheckFinite(file, p + ".center", body.center);
@@ -73,8 +99,11 @@ void ValidateWall(Config* config) {
 }  // namespace
 
 void ValidateBodiesAndWall(Config* config) {
-  for (std::size_t k = 0; k < config->bodies.size(); ++k)
-    ValidateBody(*config, fmt::format("bodies.{}", k + 1), config->bodies[k]);
+  for (std::size_t k = 0; k < config->bodies.size(); ++k) {
+    const std::string p = fmt::format("bodies.{}", k + 1);
+    ValidateBody(*config, p, config->bodies[k]);
+    ValidateSpheroid(*config, p, static_cast<int>(k), &config->bodies[k]);
+  }
   if (config->wall) ValidateWall(config);
   for (std::size_t r = 0; r < config->rods.size(); ++r) {
     const RodConfig& rod = config->rods[r];

@@ -92,6 +92,8 @@ template <class V>
 void VisitFields(BodyConfig& c, V& v) {
   v("shape", c.shape);
   v("radius", c.radius);
+  v("half_length", c.half_length);
+  v("axis", c.axis);
   v("center", c.center);
   v("motion", c.motion);
   v("velocity", c.velocity);
