@@ -115,7 +115,7 @@ def main():
     failures, kills = 0, 0
     for trial in range(args.trials):
         out = os.path.join(args.work, f"trial{trial}")
-        # Trial 1 checkpoints by wall time: restart points every 20 steps, written when due.
+        # Trial 1 checkpoints by wall time: restart points every 60 steps, written when due.
         # Trial 2 runs on two threads (the reference on one): the result must not depend on it.
         extra = common + (["--set", "run.checkpoint_wall_interval=0.3"] if trial == 1 else [])
         threads = 2 if trial == 2 else 1

@@ -22,7 +22,7 @@ struct RunProgress {
 
 struct RunOptions {
   bool resume = false;                              ///< continue from the last checkpoint
-  /// Polled every step (e.g. SIGINT seen): the run goes on to the next restart point (at most 20
+  /// Polled every step (e.g. SIGINT seen): the run goes on to the next restart point (at most 60
   /// steps), writes a checkpoint there and stops, so that --resume continues it exactly.
   std::function<bool()> interrupted;
   /// Polled every step (e.g. a second SIGINT): stop after the current step; checkpoint.bin keeps
@@ -33,8 +33,12 @@ struct RunOptions {
 
 /// Restart points: after every kRestartSteps-th step and every checkpoint step a run forgets the
 /// factors it reuses across steps (sim/integrator.h ForgetReuse), so that a run resumed there
-/// continues bit for bit. 20 is the Krylov preconditioner's own largest age: no extra rebuilds.
-constexpr long kRestartSteps = 20;
+/// continues bit for bit. A multiple of the Krylov preconditioner's own largest age (20): no extra
+/// rebuilds of it. Every restart point also drops the dense 𝕄's reuse history, which takes a few
+/// assemblies to build again: 60 instead of 20 steps apart, Fig. 1 at h = 1 ms assembles 0.13
+/// times per step instead of 0.3 and costs 12 % less (docs/performance.md); an interrupt then
+/// waits up to 60 steps.
+constexpr long kRestartSteps = 60;
 
 struct RunResult {
   RunStatus status = RunStatus::kCompleted;
