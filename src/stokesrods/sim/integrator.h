@@ -80,6 +80,8 @@ struct Workspace {
   /// the next step's first guess extrapolates the drag through them (PredictDrag).
   std::array<VecX, 2> earlier_drags;
   VecX drag_at_start;            ///< the drag at t_k (3M), restored when the step fails
+  bool drag_extrapolated = false; ///< this step's first guess of the drag was extrapolated
+  bool extrapolate_drag = true;   ///< off while a failed step is retried from f_k (Step)
   std::vector<BodyPose> previous_poses;  ///< the bodies at t_{k−1}, for BDF2
   BodyStep body_step;            ///< how the bodies move in the step (sim/bodies.h)
   State step_start;              ///< the start of the step in implicit Euler's form (see Step)
