@@ -161,9 +161,10 @@ bool SameValue(const std::string& a, const std::string& b) {
 }
 
 bool Matches(const SweepAdjust& adjust, const std::vector<std::pair<std::string, std::string>>& values) {
-  for (const auto& [key, text] : adjust.where) {
+  for (const auto& entry : adjust.where) {  // not a structured binding: clang 14 cannot capture one
+    const std::string& key = entry.first;
     const auto it = std::find_if(values.begin(), values.end(), [&](const auto& kv) { return kv.first == key; });
-    if (it == values.end() || !SameValue(it->second, text)) return false;
+    if (it == values.end() || !SameValue(it->second, entry.second)) return false;
   }
   return true;
 }
