@@ -15,6 +15,7 @@
 #include <omp.h>
 #endif
 
+#include "stokesrods/fluid/point_stokeslet.h"
 #include "stokesrods/fluid/stokeslet_segment.h"
 
 namespace stokesrods {
@@ -243,6 +244,46 @@ TEST(StokesletSumTest, SinglePrecisionDirectSumIsWellWithinItsTolerance) {
   }
 }
 
+// The near field's kernel over several ranges of whole blocks, with padding sources of zero
+// strength as the FMM lays them out, against the plain loop over the real sources in double:
+// within float rounding (1e-6 relative to Σ|S||g|, well under kSinglePrecisionTolerance).
+TEST(StokesletSumTest, BlockKernelOverRangesMatchesThePlainSum) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> unit(-0.1, 0.1), size(0.5e-3, 2e-3);
+  const int blocks = 9;
+  Eigen::MatrixXf padded = Eigen::MatrixXf::Zero(blocks * kPointSumBlock, 7);
+  MatX real(0, 7);
+  std::vector<SourceRange> ranges = {{0, 2 * kPointSumBlock}, {3 * kPointSumBlock, 4 * kPointSumBlock},
+                                     {6 * kPointSumBlock, 9 * kPointSumBlock}};
+  for (const SourceRange& r : ranges)
+    for (int s = r.begin; s < r.end; ++s) {
+      if (s % 5 == 4) {  // padding: zero strength, any finite point, ε² = 1
+        padded.row(s) << 0.05f, -0.02f, 0.01f, 1.0f, 0.0f, 0.0f, 0.0f;
+        continue;
+      }
+      Eigen::Matrix<double, 1, 7> row;
+      const double eps = size(rng);
+      row << unit(rng), unit(rng), unit(rng), eps * eps, unit(rng), unit(rng), unit(rng);
+      padded.row(s) = row.cast<float>();
+      real.conservativeResize(real.rows() + 1, 7);
+      real.row(real.rows() - 1) = padded.row(s).cast<double>();  // the same rounded points
+    }
+  for (int trial = 0; trial < 20; ++trial) {
+    const Vec3 x(unit(rng), unit(rng), unit(rng));
+    const Eigen::Vector3f xf = x.cast<float>();
+    double w[3] = {0.0, 0.0, 0.0}, ref[3] = {0.0, 0.0, 0.0};
+    AddPointSumBlocks(ColumnsF(padded), ranges.data(), static_cast<int>(ranges.size()), xf.data(), w);
+    const Vec3 xd = xf.cast<double>();
+    AddPointSum(Columns(real), 0, real.rows(), xd.data(), ref);
+    double scale = 0.0;  // Σ |S(x − y_s)|₂ |g_s| ≤ Σ (2/R + ...) |g_s|: bounded by (1/R + ε²/R³ + 1/R) |g|
+    for (Eigen::Index s = 0; s < real.rows(); ++s) {
+      const Vec3 r = xd - real.row(s).head<3>().transpose();
+      const double big_r = std::sqrt(r.squaredNorm() + real(s, 3));
+      scale += (2.0 / big_r + real(s, 3) / std::pow(big_r, 3)) * real.row(s).tail<3>().norm();
+    }
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(w[c], ref[c], 1e-6 * scale) << trial;
+  }
+}
 
 // A run resumes bit for bit on another thread count (tests/reliability/kill_resume.py), so the
 // fast sum's result must not depend on it: OpenMP splits only independent boxes (here 1 against 2

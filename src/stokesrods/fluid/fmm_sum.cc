@@ -5,7 +5,9 @@
 // surface and fitted by upward equivalent densities), M2M up to level 2, M2L over the V lists of
 // every level (the dense K_v, all pairs of one offset in one BLAS product), L2L down, L2T (the
 // downward equivalent densities evaluated at the targets), and the near field (the 27 neighbouring
-// leaves) summed directly with the regularized kernel by the vectorized loop of the direct sum.
+// leaves) summed directly with the regularized kernel by the vectorized loop of the direct sum:
+// each leaf's sources padded to whole SIMD blocks by sources of zero strength, and a target's
+// neighbour leaves summed in one call (AddPointSumBlocks: no remainder loops, one reduction).
 // Every box's work is done by one thread, in a fixed order: Apply is deterministic.
 //
 // DEPTH. The tree is cut at the depth of least estimated cost (FmmCost: kernel evaluations of the
@@ -101,6 +103,7 @@ class FmmStokesletSum final : public StokesletSum {
   void Leaves(Matrix3X* w) const;
   void M2l(int level) const;
   void GroupM2l();
+  void PadSources(const Matrix3X& sources, const VecX& regularization);
 
   StokesletSumOptions options_;
   bool single_ = false;  // near field and S2M in single precision (stokeslet_sum.h)
@@ -109,7 +112,15 @@ class FmmStokesletSum final : public StokesletSum {
   const FmmOperators* op_ = nullptr;
   FmmTree tree_;
   Matrix3X x_;        // targets in tree order
-  mutable MatX src_;  // S × 7 sources in tree order (point_stokeslet.h), current strengths
+  // S' × 7 sources in tree order (point_stokeslet.h) with the current strengths, each leaf's
+  // padded to whole blocks of kPointSumBlock by sources of zero strength: slot s holds source
+  // slot_source_[s] (−1: padding); leaf b's slots are leaf_sources_[b]; the near field of leaf
+  // b's targets is the slots near_ranges_[near_range_start_[b], near_range_start_[b + 1]).
+  mutable MatX src_;
+  Eigen::Index num_sources_ = 0;
+  std::vector<int> slot_source_;
+  std::vector<SourceRange> leaf_sources_, near_ranges_;
+  std::vector<int> near_range_start_;
   Vec3 origin_ = Vec3::Zero();     // single precision: positions relative to it
   mutable Eigen::MatrixXf src_f_;  // src_ in single precision
   Eigen::Matrix3Xf x_f_;           // x_ in single precision
@@ -174,13 +185,8 @@ void FmmStokesletSum::Build(const Matrix3X& sources, const VecX& regularization,
     stats_ = direct_->Stats();
     return;
   }
-  const auto ns = static_cast<Eigen::Index>(sources.cols());
-  src_.resize(ns, 7);
-  for (Eigen::Index s = 0; s < ns; ++s) {
-    const int k = tree_.source_order[static_cast<size_t>(s)];
-    src_.row(s).head<3>() = sources.col(k).transpose();
-    src_(s, 3) = regularization[k] * regularization[k];
-  }
+  PadSources(sources, regularization);
+  const auto ns = static_cast<Eigen::Index>(src_.rows());
   x_.resize(3, targets.cols());
   for (Eigen::Index t = 0; t < targets.cols(); ++t)
     x_.col(t) = targets.col(tree_.target_order[static_cast<size_t>(t)]);
@@ -208,6 +214,54 @@ void FmmStokesletSum::Build(const Matrix3X& sources, const VecX& regularization,
   GroupM2l();
 }
 
+// The padded source layout (see the members) and the near field's ranges of slots, contiguous
+// neighbours merged.
+void FmmStokesletSum::PadSources(const Matrix3X& sources, const VecX& regularization) {
+  const auto& leaves = tree_.levels[static_cast<size_t>(tree_.depth)];
+  num_sources_ = sources.cols();
+  leaf_sources_.assign(leaves.size(), SourceRange{});
+  slot_source_.clear();
+  for (std::size_t b = 0; b < leaves.size(); ++b) {
+    leaf_sources_[b].begin = static_cast<int>(slot_source_.size());
+    for (int s = leaves[b].src_begin; s < leaves[b].src_end; ++s)
+      slot_source_.push_back(tree_.source_order[static_cast<size_t>(s)]);
+    while (slot_source_.size() % kPointSumBlock != 0) slot_source_.push_back(-1);
+    leaf_sources_[b].end = static_cast<int>(slot_source_.size());
+  }
+  const auto slots = static_cast<Eigen::Index>(slot_source_.size());
+  src_.setZero(slots, 7);
+  for (Eigen::Index s = 0; s < slots; ++s) {
+    const int k = slot_source_[static_cast<size_t>(s)];
+    if (k < 0) {  // zero strength at the previous slot's place (any finite point), ε² = 1
+      if (s > 0) src_.row(s).head<3>() = src_.row(s - 1).head<3>();
+      src_(s, 3) = 1.0;
+      continue;
+    }
+    src_.row(s).head<3>() = sources.col(k).transpose();
+    src_(s, 3) = regularization[k] * regularization[k];
+  }
+  near_range_start_.assign(1, 0);
+  near_ranges_.clear();
+  std::vector<SourceRange> ranges;
+  for (std::size_t b = 0; b < leaves.size(); ++b) {
+    ranges.clear();
+    for (int e = tree_.near.start[b]; e < tree_.near.start[b + 1]; ++e) {
+      const SourceRange r = leaf_sources_[static_cast<size_t>(tree_.near.box[static_cast<size_t>(e)])];
+      if (r.end > r.begin) ranges.push_back(r);
+    }
+    std::sort(ranges.begin(), ranges.end(),
+              [](const SourceRange& p, const SourceRange& q) { return p.begin < q.begin; });
+    for (const SourceRange& r : ranges) {
+      if (near_ranges_.size() > static_cast<size_t>(near_range_start_.back()) &&
+          near_ranges_.back().end == r.begin)
+        near_ranges_.back().end = r.end;
+      else
+        near_ranges_.push_back(r);
+    }
+    near_range_start_.push_back(static_cast<int>(near_ranges_.size()));
+  }
+}
+
 void FmmStokesletSum::GroupM2l() {
   m2l_pairs_.assign(static_cast<size_t>(tree_.depth) + 1, {});
   for (int l = 2; l <= tree_.depth; ++l) {
@@ -222,9 +276,11 @@ void FmmStokesletSum::GroupM2l() {
 
 void FmmStokesletSum::Apply(const Matrix3X& strengths, Matrix3X* w) const {
   if (use_direct_) return direct_->Apply(strengths, w);
-  SR_ASSERT(strengths.cols() == src_.rows(), "one strength per source");
-  for (Eigen::Index s = 0; s < src_.rows(); ++s)
-    src_.row(s).tail<3>() = strengths.col(tree_.source_order[static_cast<size_t>(s)]).transpose();
+  SR_ASSERT(strengths.cols() == num_sources_, "one strength per source");
+  for (Eigen::Index s = 0; s < src_.rows(); ++s) {
+    const int k = slot_source_[static_cast<size_t>(s)];
+    if (k >= 0) src_.row(s).tail<3>() = strengths.col(k).transpose();  // padding stays zero
+  }
   if (single_) src_f_.rightCols<3>() = src_.rightCols<3>().cast<float>();
   Upward();
   Downward();
@@ -250,14 +306,15 @@ void FmmStokesletSum::Upward() const {
     const FmmBox& box = boxes[b];
     if (!box.has_sources()) continue;
     const Vec3 centre = tree_.BoxCentre(leaf, box.code);
+    const SourceRange own = leaf_sources_[b];
     for (int i = 0; i < n; ++i) {
       const Vec3 p = centre + (kFmmOuterRadius * width) * op_->surface.col(i);
       double* out = check.col(static_cast<Eigen::Index>(b)).data() + 3 * i;
       if (single_) {
         const Eigen::Vector3f pf = (p - origin_).cast<float>();
-        AddPointSumSingle(columns_f, box.src_begin, box.src_end, pf.data(), out);
+        AddPointSumBlocks(columns_f, &own, 1, pf.data(), out);
       } else {
-        AddPointSum(columns, box.src_begin, box.src_end, p.data(), out);
+        AddPointSum(columns, own.begin, own.end, p.data(), out);
       }
     }
   }
@@ -371,12 +428,13 @@ void FmmStokesletSum::Leaves(Matrix3X* w) const {
       for (int t = box.tgt_begin; t < box.tgt_end; ++t) {
         double* out = w->col(t).data();
         AddPointSum(far, 0, n, x_.col(t).data(), out);
-        for (int e = tree_.near.start[b]; e < tree_.near.start[b + 1]; ++e) {
-          const FmmBox& a = boxes[static_cast<size_t>(tree_.near.box[static_cast<size_t>(e)])];
-          if (single_)
-            AddPointSumSingle(columns_f, a.src_begin, a.src_end, x_f_.col(t).data(), out);
-          else
-            AddPointSum(columns, a.src_begin, a.src_end, x_.col(t).data(), out);
+        const SourceRange* near = near_ranges_.data() + near_range_start_[b];
+        const int count = near_range_start_[b + 1] - near_range_start_[b];
+        if (single_) {
+          AddPointSumBlocks(columns_f, near, count, x_f_.col(t).data(), out);
+        } else {
+          for (int r = 0; r < count; ++r)
+            AddPointSum(columns, near[r].begin, near[r].end, x_.col(t).data(), out);
         }
       }
     }

@@ -34,6 +34,21 @@ struct SourceColumnsF {
 void AddPointSumSingle(const SourceColumnsF& c, Eigen::Index begin, Eigen::Index end,
                        const float* x, double* w);
 
+/// The width of the blocks of AddPointSumBlocks: every range it is given starts at a multiple of
+/// it and holds a multiple of it (padded with sources of zero strength, which add exactly zero).
+inline constexpr int kPointSumBlock = 16;
+
+/// A range [begin, end) of sources for AddPointSumBlocks.
+struct SourceRange {
+  int begin = 0, end = 0;
+};
+
+/// AddPointSumSingle over several ranges of sources at once, each a whole number of blocks of
+/// kPointSumBlock: no remainder loop, and one reduction of the lanes per target instead of one per
+/// range (the near field of the FMM sums ~27 short ranges per target).
+void AddPointSumBlocks(const SourceColumnsF& c, const SourceRange* ranges, int count,
+                       const float* x, double* w);
+
 /// The columns of an S × 7 single-precision source matrix.
 SourceColumnsF ColumnsF(const Eigen::MatrixXf& src);
 

@@ -65,6 +65,37 @@ void AddPointSumSingle(const SourceColumnsF& c, Eigen::Index begin, Eigen::Index
   w[2] += wz;
 }
 
+__attribute__((target_clones("avx512f", "avx2", "default")))
+void AddPointSumBlocks(const SourceColumnsF& c, const SourceRange* ranges, int count,
+                       const float* x, double* w) {
+  constexpr int kLanes = kPointSumBlock;
+  const float *sx = c.x, *sy = c.y, *sz = c.z, *se2 = c.e2, *gx = c.gx, *gy = c.gy, *gz = c.gz;
+  const float px = x[0], py = x[1], pz = x[2];
+  float wx[kLanes] = {}, wy[kLanes] = {}, wz[kLanes] = {};
+  for (int r = 0; r < count; ++r) {
+    SR_DASSERT(ranges[r].begin % kLanes == 0 && ranges[r].end % kLanes == 0, "whole blocks");
+    for (int first = ranges[r].begin; first < ranges[r].end; first += kLanes) {
+#pragma omp simd
+      for (int l = 0; l < kLanes; ++l) {
+        const int s = first + l;
+        const float rx = px - sx[s], ry = py - sy[s], rz = pz - sz[s];
+        const float inv_r = 1.0f / std::sqrt(rx * rx + ry * ry + rz * rz + se2[s]);
+        const float inv_r3 = inv_r * inv_r * inv_r;
+        const float a = inv_r + se2[s] * inv_r3;
+        const float b = (rx * gx[s] + ry * gy[s] + rz * gz[s]) * inv_r3;
+        wx[l] += a * gx[s] + b * rx;
+        wy[l] += a * gy[s] + b * ry;
+        wz[l] += a * gz[s] + b * rz;
+      }
+    }
+  }
+  float sum_x = 0.0f, sum_y = 0.0f, sum_z = 0.0f;
+  for (int l = 0; l < kLanes; ++l) sum_x += wx[l], sum_y += wy[l], sum_z += wz[l];
+  w[0] += sum_x;
+  w[1] += sum_y;
+  w[2] += sum_z;
+}
+
 MatX SourceMatrix(const Matrix3X& sources, const VecX& regularization) {
   MatX src(sources.cols(), 7);
   src.leftCols<3>() = sources.transpose();
