@@ -35,11 +35,19 @@ double Since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-std::string SelfExecutable() {
+// Each case is started from /proc/self/exe, the file this process runs, not from a path: a rebuild
+// unlinks the path and links a new file there, but the kernel keeps the old file while this process
+// runs it, and posix_spawn's child (sharing this process's memory map until it execs) execs exactly
+// it. So every case of a sweep runs the scheduler's own build, however often the path is relinked.
+// A path resolved at start would run the new build (or nothing while the linker writes it); a copy
+// of the executable in the sweep folder would cost its size (~170 MB in release) in every folder.
+constexpr const char* kSelfExecutable = "/proc/self/exe";
+
+// The name the case's process gets as argv[0]: the executable's path, for `ps` and messages.
+std::string SelfName() {
   std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) throw IoError("cannot find the stokesrods executable (/proc/self/exe): " + ec.message());
-  return self.string();
+  const fs::path self = fs::read_symlink(kSelfExecutable, ec);
+  return ec ? std::string("stokesrods") : self.string();
 }
 
 // Starts `stokesrods run ...` for case c, its output in <case>/run.log. Returns the child's pid.
@@ -48,7 +56,7 @@ pid_t SpawnCase(const Sweep& sweep, const SweepCase& c, bool resume, int threads
   fs::create_directories(c.output_dir, ec);
   if (ec) throw IoError(fmt::format("{}: cannot create the case folder: {}", c.output_dir, ec.message()));
   const std::string log = (fs::path(c.output_dir) / "run.log").string();
-  std::vector<std::string> args = {SelfExecutable()};
+  std::vector<std::string> args = {SelfName()};
   for (std::string& a : CaseArguments(sweep, c, resume)) args.push_back(std::move(a));
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
@@ -73,10 +81,11 @@ pid_t SpawnCase(const Sweep& sweep, const SweepCase& c, bool resume, int threads
   posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);
   posix_spawnattr_setpgroup(&attr, 0);
   pid_t pid = 0;
-  const int rc = posix_spawn(&pid, argv[0], &actions, &attr, argv.data(), envp.data());
+  const int rc = posix_spawn(&pid, kSelfExecutable, &actions, &attr, argv.data(), envp.data());
   posix_spawnattr_destroy(&attr);
   posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0) throw IoError(fmt::format("cannot start {}: {}", argv[0], std::strerror(rc)));
+  if (rc != 0)
+    throw IoError(fmt::format("cannot start {} ({}): {}", kSelfExecutable, argv[0], std::strerror(rc)));
   return pid;
 }
 
@@ -206,6 +215,9 @@ CaseRecord RunCaseProcess(const Sweep& sweep, const SweepCase& c, bool resume, i
 }
 
 int ScheduleSweep(Sweep sweep, const SweepCommandOptions& options, RemoteWorkers* remote) {
+  // Refinement cases finished in an earlier session are listed from the start, so that sweep.json
+  // (what `analyze` reads) keeps them even if this session is interrupted before its refine pass.
+  for (SweepCase& c : KnownRefinementCases(sweep)) sweep.cases.push_back(std::move(c));
   WriteSweepJson(sweep);
   Board board(&sweep, options);
   const int remote_count = remote != nullptr ? remote->Count() : 0;

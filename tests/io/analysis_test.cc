@@ -101,5 +101,19 @@ TEST(Analysis, RefinementAddsTheMiddleOfWideBracketsOnce) {
   EXPECT_TRUE(RefinementCases(s, "rods.omega_bar", lines, 60.0).empty());  // exists already
 }
 
+// Two explicit cases with the same values but different names are two lines; each is bisected in
+// its own folders (the middle takes its line's name).
+TEST(Analysis, RefinementKeepsEachLinesName) {
+  Sweep s;
+  s.output = "out";
+  for (const char* name : {"left", "right"})
+    for (const char* w : {"100", "200"}) s.cases.push_back(MakeSweepCase(s, name, {{"rods.omega_bar", w}}));
+  const auto lines = CriticalAlongLines(s, "rods.omega_bar", {false, true, false, true});
+  const auto added = RefinementCases(s, "rods.omega_bar", lines, 60.0);
+  ASSERT_EQ(added.size(), 2u);
+  EXPECT_EQ(added[0].name, "left__omega_bar=150");
+  EXPECT_EQ(added[1].name, "right__omega_bar=150");
+}
+
 }  // namespace
 }  // namespace stokesrods

@@ -1,6 +1,7 @@
 // `stokesrods sweep` as users run it: cases in separate processes, failure isolation, resume after
 // a finished or an interrupted sweep, a failed case retried with [[adjust]], the [refine]
-// bisection, bad sweep files, and the same sweep under mpirun -n 2.
+// bisection (kept by an interrupted rerun), a relinked executable, bad sweep files, and the same
+// sweep under mpirun -n 2.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -163,6 +164,27 @@ TEST(SweepCli, BadSweepFileIsExitTwoNamingFileAndKey) {
   EXPECT_FALSE(fs::exists(dir / "out"));
 }
 
+// A sweep with a [refine] pass: writes pair.toml into `dir` and returns the sweep file's text.
+std::string PairRefineSweep(const fs::path& dir) {
+  std::ofstream(dir / "pair.toml") << "[run]\nduration = 0.02\ntime_step = 0.01\nframes = false\n"
+                                   << "[fluid]\nmodel = \"rss\"\n[[rods]]\nnodes = 11\n[[rods]]\n"
+                                   << "nodes = 11\nbase = [0.0, 0.05, 0.0]\nhelix_radius = 0.0059\n";
+  return "base = \"pair.toml\"\noutput = \"" + (dir / "out").string() +
+         "\"\n[vary]\n\"rods.1.helix_radius\" = [0.005, 0.01]\n[refine]\n"
+         "key = \"rods.1.helix_radius\"\ncriterion = \"crossed\"\nresolution = 0.001\n";
+}
+
+// `analyze` of dir/out finds one line, monotone, bracketed by (below, above].
+void ExpectOneBracket(const fs::path& dir, const std::string& below, const std::string& above) {
+  const std::string analyze = std::string(STOKESRODS_BINARY) + " analyze " + (dir / "out").string();
+  ASSERT_EQ(Shell(dir, analyze).code, 0);
+  const auto lines = ReadCsv(dir / "out" / "critical.csv");
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_EQ(lines[0].at("below"), below);
+  EXPECT_EQ(lines[0].at("above"), above);
+  EXPECT_EQ(lines[0].at("monotone"), "1");
+}
+
 // The [refine] pass end to end. Two identical helices side by side along y, rod 1's helix radius
 // varied: their tips have the same x (Δb = 0) exactly where rod 1's radius equals rod 2's, 5.9 mm.
 // Over [5, 10] mm, Δb > 0 below and < 0 above (the tips' x is set by the geometry; two 10 ms steps
@@ -170,13 +192,7 @@ TEST(SweepCli, BadSweepFileIsExitTwoNamingFileAndKey) {
 // (5.625, 6.25] is narrower than the resolution and the sweep stops.
 TEST(SweepCli, TheRefinePassBisectsTheLineToTheResolution) {
   const fs::path dir = Dir("refine");
-  std::ofstream(dir / "pair.toml") << "[run]\nduration = 0.02\ntime_step = 0.01\nframes = false\n"
-                                   << "[fluid]\nmodel = \"rss\"\n[[rods]]\nnodes = 11\n[[rods]]\n"
-                                   << "nodes = 11\nbase = [0.0, 0.05, 0.0]\nhelix_radius = 0.0059\n";
-  std::ofstream(dir / "s.toml") << "base = \"pair.toml\"\noutput = \"" << (dir / "out").string()
-                                << "\"\n[vary]\n\"rods.1.helix_radius\" = [0.005, 0.01]\n[refine]\n"
-                                << "key = \"rods.1.helix_radius\"\ncriterion = \"crossed\"\n"
-                                << "resolution = 0.001\n";
+  std::ofstream(dir / "s.toml") << PairRefineSweep(dir);
   const Outcome o = Shell(dir, Sweep(dir / "s.toml"));
   ASSERT_EQ(o.code, 0) << o.err;
   std::vector<std::string> radii;
@@ -185,12 +201,7 @@ TEST(SweepCli, TheRefinePassBisectsTheLineToTheResolution) {
     radii.push_back(row.at("rods.1.helix_radius"));
   }
   EXPECT_EQ(radii, (std::vector<std::string>{"0.005", "0.01", "0.0075", "0.00625", "0.005625"}));
-  ASSERT_EQ(Shell(dir, std::string(STOKESRODS_BINARY) + " analyze " + (dir / "out").string()).code, 0);
-  const auto lines = ReadCsv(dir / "out" / "critical.csv");
-  ASSERT_EQ(lines.size(), 1u);
-  EXPECT_EQ(lines[0].at("below"), "0.005625");
-  EXPECT_EQ(lines[0].at("above"), "0.00625");
-  EXPECT_EQ(lines[0].at("monotone"), "1");
+  ExpectOneBracket(dir, "0.005625", "0.00625");
   // A rerun finds the refinement's cases again (by their names) and runs none of them.
   const fs::path last = dir / "out" / "rod1.helix_radius=0.005625" / "summary.json";
   const auto stamp = fs::last_write_time(last);
@@ -198,6 +209,54 @@ TEST(SweepCli, TheRefinePassBisectsTheLineToTheResolution) {
   EXPECT_EQ(again.code, 0) << again.err;
   EXPECT_EQ(ReadCsv(dir / "out" / "sweep.csv").size(), 5u);
   EXPECT_EQ(fs::last_write_time(last), stamp);
+}
+
+// An interrupted rerun keeps the refinement cases an earlier session finished: they are in
+// sweep.json from the start, so `analyze` still brackets the line. The rerun runs one grid case
+// again (an [[adjust]] makes it long) and is interrupted during it, before any refine pass.
+TEST(SweepCli, AnInterruptedRerunKeepsTheRefinementCasesInSweepJson) {
+  const fs::path dir = Dir("refine_interrupt");
+  const std::string head = PairRefineSweep(dir);
+  std::ofstream(dir / "s.toml") << head;
+  ASSERT_EQ(Shell(dir, Sweep(dir / "s.toml")).code, 0);
+  std::ofstream(dir / "s.toml") << head << "[[adjust]]\n"
+                                << "where = { \"rods.1.helix_radius\" = 0.01 }\n"
+                                << "\"run.duration\" = 1000.0\n";
+  const Outcome o = Shell(dir, "timeout --preserve-status -s INT 2 " + Sweep(dir / "s.toml"));
+  EXPECT_EQ(o.code, 130) << o.err;
+  EXPECT_NE(o.err.find("5 cases in"), std::string::npos) << o.err;
+  EXPECT_EQ(o.err.find("refining"), std::string::npos) << o.err;
+  const auto rows = ReadCsv(dir / "out" / "sweep.csv");
+  ASSERT_EQ(rows.size(), 5u);
+  EXPECT_EQ(rows[1].at("status"), "interrupted");
+  EXPECT_EQ(rows[4].at("rods.1.helix_radius"), "0.005625");
+  EXPECT_EQ(rows[4].at("status"), "completed");
+  ExpectOneBracket(dir, "0.005625", "0.00625");
+}
+
+// A rebuild relinks the executable while a sweep runs (the path then names a new file). The cases
+// still start, from the sweep's own build: here the path is unlinked once the sweep has started
+// (it has opened its sweep file, a FIFO) and replaced by a script that fails.
+TEST(SweepCli, CasesStartFromTheSweepsOwnBuildAfterItsPathIsRelinked) {
+  const fs::path dir = Dir("relink");
+  const fs::path exe = dir / "stokesrods";
+  std::error_code ec;
+  fs::create_hard_link(STOKESRODS_BINARY, exe, ec);  // a copy if /tmp is another file system
+  if (ec) fs::copy_file(STOKESRODS_BINARY, exe);
+  std::ofstream(dir / "sweep.txt") << "base = \"base.toml\"\noutput = \"out\"\n[vary]\n"
+                                   << "\"rods.omega_bar\" = [100, 200]\n";
+  std::ofstream(dir / "new_build") << "#!/bin/sh\nexit 7\n";
+  ASSERT_EQ(mkfifo((dir / "s.toml").c_str(), 0600), 0);
+  // The shell's open of the FIFO for writing returns once the sweep opened it to read.
+  const Outcome o = Shell(dir, "cd " + dir.string() +
+                                   " && (./stokesrods sweep s.toml & exec 3> s.toml; rm stokesrods; "
+                                   "mv new_build stokesrods; chmod +x stokesrods; "
+                                   "cat sweep.txt >&3; exec 3>&-; wait $!)");
+  ASSERT_EQ(o.code, 0) << o.err;
+  const auto rows = ReadCsv(dir / "out" / "sweep.csv");
+  ASSERT_EQ(rows.size(), 2u);
+  for (const auto& row : rows) EXPECT_EQ(row.at("status"), "completed") << row.at("message");
+  EXPECT_EQ(Shell(dir, (dir / "stokesrods").string()).code, 7);  // the path holds the "new build"
 }
 
 #ifdef STOKESRODS_MPIEXEC

@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "stokesrods/io/config.h"
 #include "stokesrods/io/writers.h"
 #include "stokesrods/sim/observables.h"
 
@@ -121,6 +122,7 @@ std::vector<LineResult> CriticalAlongLines(const Sweep& sweep, const std::string
   for (std::size_t i = 0; i < sweep.cases.size(); ++i) {
     const SweepCase& c = sweep.cases[i];
     LineResult probe;
+    probe.prefix = c.prefix;
     std::optional<double> value;
     for (const auto& [k, text] : c.values) {
       if (k == key) value = std::strtod(text.c_str(), nullptr);
@@ -145,6 +147,30 @@ std::vector<LineResult> CriticalAlongLines(const Sweep& sweep, const std::string
   return results;
 }
 
+namespace {
+
+// The case of `sweep` on the line of `prefix` and `fixed` (the other varied keys) with `key` at
+// `text`, built like the line's grid case (its [set] and [[adjust]]); none: no case on that line.
+std::optional<SweepCase> CaseOnLine(const Sweep& sweep, const std::string& key,
+                                    const std::string& prefix,
+                                    const std::vector<std::pair<std::string, std::string>>& fixed,
+                                    const std::string& text) {
+  for (const SweepCase& c : sweep.cases) {
+    if (c.prefix != prefix) continue;
+    std::vector<std::pair<std::string, std::string>> others;
+    for (const auto& kv : c.values)
+      if (kv.first != key) others.push_back(kv);
+    if (others != fixed) continue;
+    std::vector<std::pair<std::string, std::string>> values = c.values;
+    for (auto& kv : values)
+      if (kv.first == key) kv.second = text;
+    return MakeSweepCase(sweep, c.prefix, std::move(values));
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 std::vector<SweepCase> RefinementCases(const Sweep& sweep, const std::string& key,
                                        const std::vector<LineResult>& lines, double resolution) {
   std::set<std::string> existing;
@@ -152,21 +178,45 @@ std::vector<SweepCase> RefinementCases(const Sweep& sweep, const std::string& ke
   std::vector<SweepCase> added;
   for (const LineResult& line : lines) {
     if (!line.below || !line.above || *line.above - *line.below <= resolution) continue;
-    // Find the prefix of the line's cases and rebuild the values in the sweep's column order.
-    for (const SweepCase& c : sweep.cases) {
-      std::vector<std::pair<std::string, std::string>> fixed;
-      for (const auto& kv : c.values)
-        if (kv.first != key) fixed.push_back(kv);
-      if (fixed != line.fixed) continue;
-      std::vector<std::pair<std::string, std::string>> values = c.values;
-      for (auto& [k, text] : values)
-        if (k == key) text = fmt::format("{}", 0.5 * (*line.below + *line.above));
-      SweepCase mid = MakeSweepCase(sweep, c.prefix, std::move(values));
-      if (existing.insert(mid.name).second) added.push_back(std::move(mid));
-      break;
-    }
+    std::optional<SweepCase> mid = CaseOnLine(sweep, key, line.prefix, line.fixed,
+                                              fmt::format("{}", 0.5 * (*line.below + *line.above)));
+    if (mid && existing.insert(mid->name).second) added.push_back(std::move(*mid));
   }
   return added;
+}
+
+std::vector<SweepCase> KnownRefinementCases(const Sweep& sweep) {
+  if (!sweep.refine || !fs::exists(fs::path(sweep.output) / "sweep.json")) return {};
+  const std::string& key = sweep.refine->key;
+  Sweep before;
+  try {
+    before = ReadSweepJson(sweep.output);
+  } catch (const IoError&) {
+    return {};  // unreadable: nothing is known (the sweep rewrites it)
+  }
+  std::set<std::string> names;
+  for (const SweepCase& c : sweep.cases) names.insert(c.name);
+  std::vector<SweepCase> known;
+  for (const SweepCase& old : before.cases) {
+    std::vector<std::pair<std::string, std::string>> fixed;
+    const std::string* text = nullptr;
+    for (const auto& kv : old.values) {
+      if (kv.first == key) text = &kv.second;
+      else fixed.push_back(kv);
+    }
+    if (text == nullptr || names.count(old.name) != 0) continue;
+    std::optional<SweepCase> c = CaseOnLine(sweep, key, old.prefix, fixed, *text);
+    if (!c || c->name != old.name) continue;  // no longer on a line of this sweep
+    try {
+      const std::string status = ReadCaseRecord(sweep, *c).status;
+      if (status != "completed" && status != "failed") continue;  // the refine pass adds it
+    } catch (const ConfigError&) {
+      continue;  // its values no longer make a valid configuration
+    }
+    names.insert(c->name);
+    known.push_back(std::move(*c));
+  }
+  return known;
 }
 
 }  // namespace stokesrods

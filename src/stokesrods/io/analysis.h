@@ -54,6 +54,7 @@ std::string CriterionRule(const std::string& criterion);
 /// The critical value of `key` on one line of a sweep (the other varied keys fixed): the outcome
 /// switches from no (below) to yes (at and above) between `below` and `above`.
 struct LineResult {
+  std::string prefix;  ///< the line's explicit case name ("" if none)
   std::vector<std::pair<std::string, std::string>> fixed;  ///< the other varied keys
   std::optional<double> below, above;  ///< bracket; one side missing: all yes / all no
   bool monotone = true;                ///< false: a yes below a no on this line
@@ -69,5 +70,12 @@ std::vector<LineResult> CriticalAlongLines(const Sweep& sweep, const std::string
 /// (the line's fixed values, `key` at the midpoint). Cases that already exist are not repeated.
 std::vector<SweepCase> RefinementCases(const Sweep& sweep, const std::string& key,
                                        const std::vector<LineResult>& lines, double resolution);
+
+/// The refinement cases an earlier run of this sweep left (listed in <output>/sweep.json) that are
+/// still on one of its lines (a grid case's values but `refine.key`'s, same name) and finished
+/// (completed or failed) with the settings they have now. The sweep lists them from its start, so
+/// an interrupted rerun keeps them in sweep.json, which is what `analyze` reads. None without
+/// [refine].
+std::vector<SweepCase> KnownRefinementCases(const Sweep& sweep);
 
 }  // namespace stokesrods
