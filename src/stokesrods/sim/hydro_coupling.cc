@@ -6,33 +6,10 @@
 #include "stokesrods/common/assert.h"
 #include "stokesrods/sim/bodies.h"
 #include "stokesrods/sim/state.h"
-#include "stokesrods/solver/blas.h"
 #include "stokesrods/solver/gmres.h"
 
 namespace stokesrods {
 
-namespace {
-
-// t = Σ_j over n points of (1/R + ε_j²/R³, then r rᵀ/R³ as xx, xy, xz, yy, yz, zz),
-// r = p − x_j, R² = |r|² + ε_j²: the point Stokeslets S_ε of a chunk of nodes at p, summed.
-__attribute__((target_clones("avx512f", "avx2", "default")))
-void SumPointStokeslets(const double* xs, const double* ys, const double* zs, const double* e2,
-                        int n, const double* p, double t[7]) {
-  const double px = p[0], py = p[1], pz = p[2];
-  double diag = 0, sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0;
-#pragma omp simd reduction(+ : diag, sxx, sxy, sxz, syy, syz, szz)
-  for (int j = 0; j < n; ++j) {
-    const double rx = px - xs[j], ry = py - ys[j], rz = pz - zs[j];
-    const double inv = 1.0 / std::sqrt(rx * rx + ry * ry + rz * rz + e2[j]);
-    const double inv3 = inv * inv * inv;
-    diag += inv + e2[j] * inv3;
-    sxx += rx * rx * inv3, sxy += rx * ry * inv3, sxz += rx * rz * inv3;
-    syy += ry * ry * inv3, syz += ry * rz * inv3, szz += rz * rz * inv3;
-  }
-  t[0] = diag, t[1] = sxx, t[2] = sxy, t[3] = sxz, t[4] = syy, t[5] = syz, t[6] = szz;
-}
-
-}  // namespace
 
 void GatherNodeVelocities(const Model& model, const VecX& q, const VecX& q_start, double h,
                           VecX* u) {
@@ -173,7 +150,7 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
         blocks[r] = h * mobility_->SelfBlock(static_cast<int>(r)) + sx_blocks_[r];
         if (!block_lu_[r].Compute(blocks[r].cast<float>())) return have_preconditioner_ = false;
       }
-      BuildCoarseLevel(model, h, blocks);
+      if (!BuildCoarseLevel(model, h, blocks)) return have_preconditioner_ = false;
     } else {
       MatX capacitance = h * *mobility_->matrix();
       for (std::size_t r = 0; r < model.rods.size(); ++r) {
@@ -243,63 +220,14 @@ void HydroCoupling::ApplyCapacitance(const Model& model, double h, const VecX& v
   if (borders_) ApplyClampBorders(model, h, *borders_, v, scratch_dofs_, out);
 }
 
-void HydroCoupling::BuildCoarseLevel(const Model& model, double h,
+bool HydroCoupling::BuildCoarseLevel(const Model& model, double h,
                                      const std::vector<MatX>& blocks) {
-  constexpr int kChunksPerRod = 4;
-  chunk_first_.clear();
-  std::vector<int> chunk_rod;
-  for (std::size_t r = 0; r < model.rods.size(); ++r) {
-    const int n = model.rods[r].num_nodes(), first = model.rods[r].node_offset;
-    const int chunks = std::min(kChunksPerRod, n);
-    for (int a = 0; a < chunks; ++a) {
-      chunk_first_.push_back(first + a * n / chunks);
-      chunk_rod.push_back(static_cast<int>(r));
-    }
-  }
-  const int m = model.num_nodes, nc = static_cast<int>(chunk_first_.size());
-  chunk_first_.push_back(m);
-  std::vector<int> node_rod(static_cast<size_t>(m));
-  for (std::size_t r = 0; r < model.rods.size(); ++r)
-    std::fill_n(node_rod.begin() + model.rods[r].node_offset, model.rods[r].num_nodes(),
-                static_cast<int>(r));
-  Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor> x(3, m);  // rows contiguous
-  VecX eps2(m);
-  for (std::size_t r = 0; r < model.rods.size(); ++r) {
-    x.middleCols(model.rods[r].node_offset, model.rods[r].num_nodes()) = positions_[r];
-    eps2.segment(model.rods[r].node_offset, model.rods[r].num_nodes()).setConstant(
-        std::pow(model.fluid.regularization * model.rods[r].radius, 2));
-  }
-  coarse_w_.setZero(3 * m, 3 * nc);
-  const double scale = h / (8.0 * kPi * model.fluid.viscosity);
-#pragma omp parallel for schedule(dynamic, 16)
-  for (int i = 0; i < m; ++i) {
-    const int rod_i = node_rod[static_cast<size_t>(i)];
-    const Vec3 point = x.col(i);
-    const int first_i = model.rods[static_cast<size_t>(rod_i)].node_offset;
-    for (int b = 0; b < nc; ++b) {
-      const int rod_b = chunk_rod[static_cast<size_t>(b)];
-      Mat3 sum = Mat3::Zero();
-      if (rod_b == rod_i) {  // within the rod: the exact block, columns of the chunk summed
-        for (int j = chunk_first_[static_cast<size_t>(b)]; j < chunk_first_[static_cast<size_t>(b) + 1]; ++j)
-          sum += blocks[static_cast<size_t>(rod_i)].block<3, 3>(3 * (i - first_i), 3 * (j - first_i));
-      } else {               // between rods: a point Stokeslet per node (the nodal force F_j)
-        const int begin = chunk_first_[static_cast<size_t>(b)];
-        const int end = chunk_first_[static_cast<size_t>(b) + 1];
-        double t[7];  // Σ (1/R + ε²/R³), then the six entries of Σ r rᵀ/R³
-        SumPointStokeslets(x.row(0).data() + begin, x.row(1).data() + begin,
-                           x.row(2).data() + begin, eps2.data() + begin, end - begin,
-                           point.data(), t);
-        sum << t[0] + t[1], t[2], t[3], t[2], t[0] + t[4], t[5], t[3], t[5], t[0] + t[6];
-        sum *= scale;
-      }
-      coarse_w_.block<3, 3>(3 * i, 3 * b) = sum.cast<float>();
-    }
-  }
-  MatX e = MatX::Zero(3 * nc, 3 * nc);  // E = Zᵀ W: rows of W summed over each chunk
-  for (int a = 0; a < nc; ++a)
-    for (int i = chunk_first_[static_cast<size_t>(a)]; i < chunk_first_[static_cast<size_t>(a) + 1]; ++i)
-      e.middleRows<3>(3 * a) += coarse_w_.middleRows<3>(3 * i).cast<double>();
-  coarse_lu_.compute(e);
+  std::vector<CoarseRod> rods(model.rods.size());
+  for (std::size_t r = 0; r < rods.size(); ++r)
+    rods[r] = {.x = &positions_[r],
+               .eps = model.fluid.regularization * model.rods[r].radius,
+               .node_offset = model.rods[r].node_offset};
+  return coarse_.Build(rods, blocks, h / (8.0 * kPi * model.fluid.viscosity));
 }
 
 void HydroCoupling::Precondition(const VecX& v, VecX* out) const {
@@ -310,15 +238,10 @@ void HydroCoupling::Precondition(const VecX& v, VecX* out) const {
     return;
   }
   // Coarse: c = E⁻¹ Zᵀ v; then the blocks on what the coarse correction leaves, y = Zc + D⁻¹(v − Wc).
-  const int nc = static_cast<int>(chunk_first_.size()) - 1;
-  VecX zv = VecX::Zero(3 * nc);
-  for (int a = 0; a < nc; ++a)
-    for (int i = chunk_first_[static_cast<size_t>(a)]; i < chunk_first_[static_cast<size_t>(a) + 1]; ++i)
-      zv.segment<3>(3 * a) += v.segment<3>(3 * i);
-  const VecX coarse = coarse_lu_.solve(zv);
-  Eigen::VectorXf wc;
-  Gemv(coarse_w_, coarse.cast<float>(), &wc);
-  const VecX rest = v - wc.cast<double>();
+  const VecX coarse = coarse_.Solve(v);
+  VecX wc;
+  coarse_.ApplyW(coarse, &wc);
+  const VecX rest = v - wc;
   out->resize(v.size());
   const int num_rods = mobility_->num_rods();
 #pragma omp parallel for schedule(static) if (num_rods > 1)
@@ -329,9 +252,7 @@ void HydroCoupling::Precondition(const VecX& v, VecX* out) const {
     block_lu_[static_cast<size_t>(r)].Solve(&x);
     out->segment(first, n) = x.cast<double>();
   }
-  for (int a = 0; a < nc; ++a)
-    for (int i = chunk_first_[static_cast<size_t>(a)]; i < chunk_first_[static_cast<size_t>(a) + 1]; ++i)
-      out->segment<3>(3 * i) += coarse.segment<3>(3 * a);
+  coarse_.AddZ(coarse, out);
 }
 
 HydroSolveReport HydroCoupling::SolveNewtonSystem(const Model& model,

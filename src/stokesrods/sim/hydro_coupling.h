@@ -13,10 +13,11 @@
 //   krylov: by GMRES with products h 𝕄 v + S X v (𝕄 matrix-free or dense) and a preconditioner
 //           kept across steps, rebuilt with the Newton factors or when GMRES slows:
 //           dense 𝕄: the LU of the whole C;
-//           matrix-free: two levels. Coarse: per rod, K chunks of consecutive nodes with a
-//           uniform force each (columns Z, 3K per rod), the coarse operator E = Zᵀ W with
-//           W ≈ C Z (within a rod from the exact blocks, between rods from point Stokeslets
-//           node to node, O(M²) once per rebuild). Fine: the LU of the per-rod blocks
+//           matrix-free: two levels. Coarse (sim/coarse_level.h): per rod, K chunks of
+//           consecutive nodes with a uniform force each (columns Z, 3K per rod), the coarse
+//           operator E = Zᵀ W with W ≈ C Z (within a rod from the exact blocks, between rods
+//           a point Stokeslet at each chunk's centroid; W c a Stokeslet sum, W never stored).
+//           Fine: the LU of the per-rod blocks
 //           D_k = h 𝕄_kk + S_k X_k. One application: c = E⁻¹ Zᵀ r, y = Z c + D⁻¹ (r − W c).
 //           Block Jacobi alone misses the collective flow of many rods (GMRES then needs
 //           5–6× more products); the coarse level carries it.
@@ -31,6 +32,7 @@
 
 #include "stokesrods/fluid/mobility_operator.h"
 #include "stokesrods/sim/clamp_border.h"
+#include "stokesrods/sim/coarse_level.h"
 #include "stokesrods/sim/forces.h"
 #include "stokesrods/sim/model.h"
 #include "stokesrods/sim/state.h"
@@ -128,11 +130,8 @@ class HydroCoupling {
   Eigen::PartialPivLU<MatX> capacitance_lu_;  ///< direct: the reference, Eigen's own LU
   DenseLu<float> capacitance_lu_float_;
   std::vector<DenseLu<float>> block_lu_;      ///< the per-rod blocks D_k (single precision)
-  void BuildCoarseLevel(const Model& model, double h, const std::vector<MatX>& blocks);
-  std::vector<int> chunk_first_;   ///< first global node of each chunk; back() = M
-  Eigen::MatrixXf coarse_w_;       ///< W ≈ C Z (3M × 3 chunks), single precision (a
-                                   ///< preconditioner; half the memory each product streams)
-  Eigen::PartialPivLU<MatX> coarse_lu_;  ///< of E = Zᵀ W
+  bool BuildCoarseLevel(const Model& model, double h, const std::vector<MatX>& blocks);
+  CoarseLevel coarse_;             ///< of the two-level preconditioner (sim/coarse_level.h)
   bool block_preconditioner_ = false;
   int iterations_after_refresh_ = -1;
   bool have_preconditioner_ = false;

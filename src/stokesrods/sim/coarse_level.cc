@@ -1,0 +1,209 @@
+#include "stokesrods/sim/coarse_level.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "stokesrods/common/assert.h"
+
+namespace stokesrods {
+
+namespace {
+
+// t = Σ_j over n points of (1/R + ε²/R³, then r rᵀ/R³ as xx, xy, xz, yy, yz, zz), r = p − x_j,
+// R² = |r|² + ε²: the point Stokeslets S_ε between p and a chunk of nodes, summed.
+__attribute__((target_clones("avx512f", "avx2", "default")))
+void SumPointStokeslets(const double* xs, const double* ys, const double* zs, double e2, int n,
+                        const double* p, double t[7]) {
+  const double px = p[0], py = p[1], pz = p[2];
+  double diag = 0, sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0;
+#pragma omp simd reduction(+ : diag, sxx, sxy, sxz, syy, syz, szz)
+  for (int j = 0; j < n; ++j) {
+    const double rx = px - xs[j], ry = py - ys[j], rz = pz - zs[j];
+    const double inv = 1.0 / std::sqrt(rx * rx + ry * ry + rz * rz + e2);
+    const double inv3 = inv * inv * inv;
+    diag += inv + e2 * inv3;
+    sxx += rx * rx * inv3, sxy += rx * ry * inv3, sxz += rx * rz * inv3;
+    syy += ry * ry * inv3, syz += ry * rz * inv3, szz += rz * rz * inv3;
+  }
+  t[0] = diag, t[1] = sxx, t[2] = sxy, t[3] = sxz, t[4] = syy, t[5] = syz, t[6] = szz;
+}
+
+Mat3 StokesletMatrix(const double t[7]) {
+  Mat3 s;
+  s << t[0] + t[1], t[2], t[3], t[2], t[0] + t[4], t[5], t[3], t[5], t[0] + t[6];
+  return s;
+}
+
+}  // namespace
+
+bool CoarseLevel::Build(const std::vector<CoarseRod>& rods, const std::vector<MatX>& blocks,
+                        double scale) {
+  SR_ASSERT(blocks.size() == rods.size(), "one block per rod");
+  scale_ = scale;
+  chunk_first_.clear();
+  chunk_rod_.clear();
+  rod_first_chunk_.clear();
+  rod_first_node_.clear();
+  for (std::size_t r = 0; r < rods.size(); ++r) {
+    const int n = static_cast<int>(rods[r].x->cols()), first = rods[r].node_offset;
+    const int chunks = std::min(kChunksPerRod, n);
+    rod_first_chunk_.push_back(static_cast<int>(chunk_first_.size()));
+    rod_first_node_.push_back(first);
+    for (int a = 0; a < chunks; ++a) {
+      chunk_first_.push_back(first + a * n / chunks);
+      chunk_rod_.push_back(static_cast<int>(r));
+    }
+  }
+  const int nc = static_cast<int>(chunk_first_.size());
+  const int m = rods.empty() ? 0 : rods.back().node_offset + static_cast<int>(rods.back().x->cols());
+  chunk_first_.push_back(m);
+  rod_first_chunk_.push_back(nc);
+  rod_first_node_.push_back(m);
+
+  // Nodes (3 × M, and by rows for the vectorized sums), chunk centroids and sizes.
+  NodeRows x(3, m);
+  for (const CoarseRod& rod : rods) x.middleCols(rod.node_offset, rod.x->cols()) = *rod.x;
+  Matrix3X centroids(3, nc);
+  VecX chunk_eps(nc);
+  chunk_nodes_.resize(nc);
+  for (int b = 0; b < nc; ++b) {
+    const int begin = chunk_first_[static_cast<size_t>(b)], end = chunk_first_[static_cast<size_t>(b) + 1];
+    chunk_nodes_(b) = end - begin;
+    centroids.col(b) = x.middleCols(begin, end - begin).rowwise().mean();
+    chunk_eps(b) = rods[static_cast<size_t>(chunk_rod_[static_cast<size_t>(b)])].eps;
+  }
+
+  // Within a rod: D_k Z_k, the block's columns summed over each chunk.
+  own_.assign(rods.size(), MatX());
+  for (std::size_t r = 0; r < rods.size(); ++r) {
+    const int first = rods[r].node_offset, n = static_cast<int>(rods[r].x->cols());
+    const int c0 = rod_first_chunk_[r], chunks = rod_first_chunk_[r + 1] - c0;
+    own_[r].setZero(3 * n, 3 * chunks);
+    for (int a = 0; a < chunks; ++a)
+      for (int j = chunk_first_[static_cast<size_t>(c0 + a)]; j < chunk_first_[static_cast<size_t>(c0 + a) + 1]; ++j)
+        own_[r].middleCols<3>(3 * a) += blocks[r].middleCols<3>(3 * (j - first));
+  }
+
+  // Between rods: the centroids' Stokeslets at the nodes (single precision, a preconditioner),
+  // corrected to the nodes' own Stokeslets where a node is near the chunk.
+  between_ = MakeFastStokesletSum({.tolerance = 1e-3});
+  between_->Build(centroids, chunk_eps, Matrix3X(x));
+  FindNearChunks(x, centroids, chunk_eps);
+
+  // E = Zᵀ W: W's rows summed over each chunk a.
+  MatX e = MatX::Zero(3 * nc, 3 * nc);
+#pragma omp parallel for schedule(dynamic, 4)
+  for (int a = 0; a < nc; ++a) {
+    const int rod_a = chunk_rod_[static_cast<size_t>(a)];
+    const int begin = chunk_first_[static_cast<size_t>(a)], end = chunk_first_[static_cast<size_t>(a) + 1];
+    const int first = rods[static_cast<size_t>(rod_a)].node_offset;
+    for (int b = 0; b < nc; ++b) {
+      const int rod_b = chunk_rod_[static_cast<size_t>(b)];
+      if (rod_b == rod_a) {
+        const int local = b - rod_first_chunk_[static_cast<size_t>(rod_a)];
+        for (int i = begin; i < end; ++i)
+          e.block<3, 3>(3 * a, 3 * b) += own_[static_cast<size_t>(rod_a)].block<3, 3>(3 * (i - first), 3 * local);
+        continue;
+      }
+      double t[7];
+      SumPointStokeslets(x.row(0).data() + begin, x.row(1).data() + begin, x.row(2).data() + begin,
+                         chunk_eps(b) * chunk_eps(b), end - begin, centroids.col(b).data(), t);
+      e.block<3, 3>(3 * a, 3 * b) = (scale * chunk_nodes_(b)) * StokesletMatrix(t);
+    }
+    for (int i = begin; i < end; ++i)
+      for (int k = near_start_[static_cast<size_t>(i)]; k < near_start_[static_cast<size_t>(i) + 1]; ++k)
+        e.block<3, 3>(3 * a, 3 * near_chunk_[static_cast<size_t>(k)]) += near_block_[static_cast<size_t>(k)];
+  }
+  lu_.compute(e);
+
+  // between_ sums every chunk, the own rod's too: take the own centroids' Stokeslets out of own_
+  // (after E, which has the exact own blocks), so that W c = own_ c_k + between_.
+  for (std::size_t r = 0; r < rods.size(); ++r) {
+    const int first = rods[r].node_offset, n = static_cast<int>(rods[r].x->cols());
+    const int c0 = rod_first_chunk_[r], chunks = rod_first_chunk_[r + 1] - c0;
+    for (int i = 0; i < n; ++i)
+      for (int a = 0; a < chunks; ++a) {
+        const int b = c0 + a;
+        double t[7];
+        SumPointStokeslets(x.row(0).data() + first + i, x.row(1).data() + first + i,
+                           x.row(2).data() + first + i, chunk_eps(b) * chunk_eps(b), 1,
+                           centroids.col(b).data(), t);
+        own_[r].block<3, 3>(3 * i, 3 * a) -= (scale * chunk_nodes_(b)) * StokesletMatrix(t);
+      }
+  }
+  return nc == 0 || (std::isfinite(lu_.rcond()) && lu_.rcond() > 0.0);
+}
+
+void CoarseLevel::FindNearChunks(const NodeRows& x, const Matrix3X& centroids,
+                                 const VecX& chunk_eps) {
+  const int nc = num_chunks(), m = chunk_first_.back();
+  VecX reach2(nc);  // (kNearReach × the chunk's radius about its centroid)²
+  for (int b = 0; b < nc; ++b) {
+    double radius2 = 0.0;
+    for (int j = chunk_first_[static_cast<size_t>(b)]; j < chunk_first_[static_cast<size_t>(b) + 1]; ++j)
+      radius2 = std::max(radius2, (Vec3(x.col(j)) - centroids.col(b)).squaredNorm());
+    reach2(b) = kNearReach * kNearReach * radius2;
+  }
+  near_start_.assign(1, 0);
+  near_chunk_.clear();
+  near_block_.clear();
+  int rod = 0;
+  for (int i = 0; i < m; ++i) {
+    while (i >= rod_first_node_[static_cast<size_t>(rod) + 1]) ++rod;
+    const Vec3 p = x.col(i);
+    for (int b = 0; b < nc; ++b) {
+      if (chunk_rod_[static_cast<size_t>(b)] == rod || (p - centroids.col(b)).squaredNorm() >= reach2(b))
+        continue;
+      const int begin = chunk_first_[static_cast<size_t>(b)], end = chunk_first_[static_cast<size_t>(b) + 1];
+      const double e2 = chunk_eps(b) * chunk_eps(b);
+      double nodes[7], centroid[7];
+      SumPointStokeslets(x.row(0).data() + begin, x.row(1).data() + begin, x.row(2).data() + begin,
+                         e2, end - begin, p.data(), nodes);
+      const double* xb = centroids.col(b).data();
+      SumPointStokeslets(xb, xb + 1, xb + 2, e2, 1, p.data(), centroid);
+      near_chunk_.push_back(b);
+      near_block_.push_back(scale_ * (StokesletMatrix(nodes) - chunk_nodes_(b) * StokesletMatrix(centroid)));
+    }
+    near_start_.push_back(static_cast<int>(near_chunk_.size()));
+  }
+}
+
+VecX CoarseLevel::Solve(const VecX& v) const {
+  const int nc = num_chunks();
+  VecX zv = VecX::Zero(3 * nc);
+  for (int a = 0; a < nc; ++a)
+    for (int i = chunk_first_[static_cast<size_t>(a)]; i < chunk_first_[static_cast<size_t>(a) + 1]; ++i)
+      zv.segment<3>(3 * a) += v.segment<3>(3 * i);
+  return lu_.solve(zv);
+}
+
+void CoarseLevel::ApplyW(const VecX& c, VecX* out) const {
+  const int nc = num_chunks(), m = chunk_first_.back();
+  strengths_.resize(3, nc);
+  for (int b = 0; b < nc; ++b) strengths_.col(b) = (scale_ * chunk_nodes_(b)) * c.segment<3>(3 * b);
+  between_->Apply(strengths_, &velocity_);  // every chunk, its own rod's too
+  out->resize(3 * m);
+  const int num_rods = static_cast<int>(own_.size());
+#pragma omp parallel for schedule(static) if (num_rods > 1)
+  for (int r = 0; r < num_rods; ++r) {
+    const int first = rod_first_node_[static_cast<size_t>(r)];
+    const int n = rod_first_node_[static_cast<size_t>(r) + 1] - first;
+    const int c0 = rod_first_chunk_[static_cast<size_t>(r)];
+    const int chunks = rod_first_chunk_[static_cast<size_t>(r) + 1] - c0;
+    out->segment(3 * first, 3 * n) = own_[static_cast<size_t>(r)] * c.segment(3 * c0, 3 * chunks);
+    for (int i = first; i < first + n; ++i) {
+      Vec3 u = velocity_.col(i);
+      for (int k = near_start_[static_cast<size_t>(i)]; k < near_start_[static_cast<size_t>(i) + 1]; ++k)
+        u += near_block_[static_cast<size_t>(k)] * c.segment<3>(3 * near_chunk_[static_cast<size_t>(k)]);
+      out->segment<3>(3 * i) += u;
+    }
+  }
+}
+
+void CoarseLevel::AddZ(const VecX& c, VecX* out) const {
+  for (int a = 0; a < num_chunks(); ++a)
+    for (int i = chunk_first_[static_cast<size_t>(a)]; i < chunk_first_[static_cast<size_t>(a) + 1]; ++i)
+      out->segment<3>(3 * i) += c.segment<3>(3 * a);
+}
+
+}  // namespace stokesrods
