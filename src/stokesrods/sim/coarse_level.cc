@@ -114,7 +114,7 @@ bool CoarseLevel::Build(const std::vector<CoarseRod>& rods, const std::vector<Ma
       for (int k = near_start_[static_cast<size_t>(i)]; k < near_start_[static_cast<size_t>(i) + 1]; ++k)
         e.block<3, 3>(3 * a, 3 * near_chunk_[static_cast<size_t>(k)]) += near_block_[static_cast<size_t>(k)];
   }
-  lu_.compute(e);
+  const bool regular = lu_.Compute(e.cast<float>());
 
   // between_ sums every chunk, the own rod's too: take the own centroids' Stokeslets out of own_
   // (after E, which has the exact own blocks), so that W c = own_ c_k + between_.
@@ -131,7 +131,7 @@ bool CoarseLevel::Build(const std::vector<CoarseRod>& rods, const std::vector<Ma
         own_[r].block<3, 3>(3 * i, 3 * a) -= (scale * chunk_nodes_(b)) * StokesletMatrix(t);
       }
   }
-  return nc == 0 || (std::isfinite(lu_.rcond()) && lu_.rcond() > 0.0);
+  return regular;
 }
 
 void CoarseLevel::FindNearChunks(const NodeRows& x, const Matrix3X& centroids,
@@ -174,7 +174,9 @@ VecX CoarseLevel::Solve(const VecX& v) const {
   for (int a = 0; a < nc; ++a)
     for (int i = chunk_first_[static_cast<size_t>(a)]; i < chunk_first_[static_cast<size_t>(a) + 1]; ++i)
       zv.segment<3>(3 * a) += v.segment<3>(3 * i);
-  return lu_.solve(zv);
+  Eigen::VectorXf c = zv.cast<float>();
+  lu_.Solve(&c);
+  return c.cast<double>();
 }
 
 void CoarseLevel::ApplyW(const VecX& c, VecX* out) const {

@@ -17,10 +17,9 @@
 #include <memory>
 #include <vector>
 
-#include <Eigen/LU>
-
 #include "stokesrods/common/types.h"
 #include "stokesrods/fluid/stokeslet_sum.h"
+#include "stokesrods/solver/dense_lu.h"
 
 namespace stokesrods {
 
@@ -35,7 +34,7 @@ class CoarseLevel {
   /// Chunks of consecutive nodes per rod (fewer when a rod has fewer nodes).
   static constexpr int kChunksPerRod = 4;
 
-  /// blocks[k] = D_k (3N_k × 3N_k), scale = h / (8πμ). False when E is singular.
+  /// blocks[k] = D_k (3N_k × 3N_k), scale = h / (8πμ). False when E is singular (a zero pivot).
   bool Build(const std::vector<CoarseRod>& rods, const std::vector<MatX>& blocks, double scale);
 
   /// c = E⁻¹ Zᵀ v (3 per chunk).
@@ -63,7 +62,8 @@ class CoarseLevel {
   VecX chunk_nodes_;               ///< N_b
   double scale_ = 0.0;
   std::unique_ptr<StokesletSum> between_;  ///< centroids → nodes
-  Eigen::PartialPivLU<MatX> lu_;   ///< of E = Zᵀ W
+  DenseLu<float> lu_;              ///< of E = Zᵀ W (single precision: 12 R × 12 R, whose solve
+                                   ///< streams the factors once per application)
   // W's corrections near chunks: node i takes near_block_[k] c_b, b = near_chunk_[k],
   // k ∈ [near_start_[i], near_start_[i + 1]).
   std::vector<int> near_start_, near_chunk_;
