@@ -118,6 +118,7 @@ class MatrixFreeRssMobility final : public MobilityOperator {
     AssembleRssMobility(params_, {rods_[static_cast<size_t>(rod)]}, &block);
     return block;
   }
+  void FindNearBlocks(const Matrix3X& targets, NearBlocks* blocks) const override;
 
  private:
   struct Segment {
@@ -125,7 +126,6 @@ class MatrixFreeRssMobility final : public MobilityOperator {
     double eps = 0.0;
     int rod = 0;
   };
-  void FindNearPairs(const Matrix3X& targets);
 
   FluidParams params_;
   double accuracy_;                 // of the far field, its quadrature and the near pairs
@@ -137,12 +137,9 @@ class MatrixFreeRssMobility final : public MobilityOperator {
   std::vector<Segment> segments_;
   Matrix3X gauss_points_;           // 3 × (segments × points)
   VecX gauss_eps_;
-  // Near corrections: for target t, blocks near_block_[k] acting on node near_source_[k],
-  // k ∈ [near_start_[t], near_start_[t + 1]).
-  std::vector<int> near_start_, near_source_;
-  std::vector<Mat3> near_block_;
-  // FindNearPairs' blocks per target before they are packed (kept: their capacity is reused).
-  std::vector<std::vector<std::pair<int, Mat3>>> per_target_;
+  NearBlocks near_;                 // the near corrections at the nodes
+  // FindNearBlocks' blocks per target before they are packed (kept: their capacity is reused).
+  mutable std::vector<std::vector<std::pair<int, Mat3>>> per_target_;
   mutable Matrix3X strengths_, far_velocity_;
 };
 
@@ -175,14 +172,14 @@ void MatrixFreeRssMobility::Update(const std::vector<HydroRod>& rods) {
     }
   }
   far_->Build(gauss_points_, gauss_eps_, nodes_);
-  FindNearPairs(nodes_);
+  FindNearBlocks(nodes_, &near_);
 }
 
 // Near pairs by bounding boxes grown by the near reach: a rod's box, then its runs of
 // kChunkSegments consecutive segments (a long rod's box holds many targets that only a few of its
 // segments are near), then every segment of a run that passes at once (vectorized). Near segments
 // come out in rod order.
-void MatrixFreeRssMobility::FindNearPairs(const Matrix3X& targets) {
+void MatrixFreeRssMobility::FindNearBlocks(const Matrix3X& targets, NearBlocks* out) const {
   const double delta2 = split_.near_delta * split_.near_delta;
   const int num_segments = static_cast<int>(segments_.size());
   // Per segment (structure of arrays): x_a, v = x_b − x_a, 1/|v|², ε², δ²|v|².
@@ -292,15 +289,15 @@ void MatrixFreeRssMobility::FindNearPairs(const Matrix3X& targets) {
       }
     }
   }
-  near_start_.assign(1, 0);
-  near_source_.clear();
-  near_block_.clear();
+  out->start.assign(1, 0);
+  out->source.clear();
+  out->block.clear();
   for (const auto& blocks : per_target) {
     for (const auto& [node, block] : blocks) {
-      near_source_.push_back(node);
-      near_block_.push_back(block);
+      out->source.push_back(node);
+      out->block.push_back(block);
     }
-    near_start_.push_back(static_cast<int>(near_source_.size()));
+    out->start.push_back(static_cast<int>(out->source.size()));
   }
 }
 
@@ -326,10 +323,7 @@ void MatrixFreeRssMobility::Apply(const VecX& force, VecX* velocity) const {
   const double scale = 1.0 / (8.0 * kPi * params_.viscosity);
 #pragma omp parallel for schedule(static)
   for (int t = 0; t < m; ++t) {
-    Vec3 u = scale * far_velocity_.col(t);
-    for (int k = near_start_[static_cast<size_t>(t)]; k < near_start_[static_cast<size_t>(t) + 1]; ++k)
-      u += near_block_[static_cast<size_t>(k)] * force.segment<3>(3 * near_source_[static_cast<size_t>(k)]);
-    velocity->segment<3>(3 * t) = u;
+    velocity->segment<3>(3 * t) = scale * far_velocity_.col(t) + near_.At(t, force);
   }
 }
 

@@ -14,7 +14,8 @@
 //                (stokeslet_sum.h). O(M) memory.
 // Further sources of flow extend the node set and the kernel behind the same interface: a wall's
 // images are in the kernel (FluidParams::wall, dense only), cell bodies' surface points follow
-// the rods' nodes in F and U (UpdateWithBodies, dense only).
+// the rods' nodes in F and U (UpdateWithBodies; dense, or the
+// matrix-free operator wrapped by fluid/mobility_sources.h).
 #pragma once
 
 #include <memory>
@@ -31,6 +32,21 @@
 namespace stokesrods {
 
 enum class MobilityKind { kDense, kMatrixFree };
+
+/// Near corrections of the matrix-free RSS at a set of targets: target t takes
+/// Σ_k block[k] F_{source[k]}, k ∈ [start[t], start[t + 1]), F the nodal forces: for each rod
+/// segment near t (δ below the split's near radius), its closed forms minus the far rule, per node.
+struct NearBlocks {
+  std::vector<int> start = {0}, source;
+  std::vector<Mat3> block;
+  /// The correction at target t for the nodal forces F (3M).
+  Vec3 At(int t, const VecX& force) const {
+    Vec3 u = Vec3::Zero();
+    for (int k = start[static_cast<size_t>(t)]; k < start[static_cast<size_t>(t) + 1]; ++k)
+      u += block[static_cast<size_t>(k)] * force.segment<3>(3 * source[static_cast<size_t>(k)]);
+    return u;
+  }
+};
 
 struct MobilityOptions {
   MobilityKind kind = MobilityKind::kDense;
@@ -79,6 +95,11 @@ class MobilityOperator {
   virtual void ForgetHistory() {}
   /// Reuse of 𝕄 across Updates, counted since the operator was made.
   virtual MobilityReuseStats reuse_stats() const { return {}; }
+  /// Matrix-free RSS: the near corrections of the rods (of the last Update) at any targets, as
+  /// the operator applies them at its own nodes (cell bodies' points: fluid/mobility_sources.h).
+  virtual void FindNearBlocks(const Matrix3X& /*targets*/, NearBlocks* /*blocks*/) const {
+    SR_ASSERT(false, "near blocks belong to the matrix-free operator");
+  }
 
   int size() const { return 3 * (node_offset_.back() + num_body_points_) + 6 * num_free_bodies_; }
   int num_rods() const { return static_cast<int>(node_offset_.size()) - 1; }

@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "stokesrods/common/assert.h"
-#include "stokesrods/fluid/rss_rows.h"
 #include "stokesrods/fluid/stokeslet_segment.h"
 #include "stokesrods/fluid/wall.h"
 
@@ -32,7 +31,6 @@ class MobilityWithBodySources final : public MobilityOperator {
   MobilityReuseStats reuse_stats() const override { return rods_operator_->reuse_stats(); }
 
  private:
-  void FindNearBlocks();
   void AddRodsAtPoints(const VecX& force, VecX* velocity) const;
 
   FluidParams params_;
@@ -46,10 +44,7 @@ class MobilityWithBodySources final : public MobilityOperator {
   Matrix3X points_;              // 3 × P
   VecX point_eps_;               // the bodies' blobs ε
   MatX body_block_;              // bodies ← bodies (3P × 3P)
-  // Near blocks of the rods at the body points: point t takes near_block_[k] × F at node
-  // near_source_[k], k ∈ [near_start_[t], near_start_[t + 1]).
-  std::vector<int> near_start_, near_source_;
-  std::vector<Mat3> near_block_;
+  NearBlocks near_;              // of the rods at the body points (the rods' operator's)
 };
 
 void MobilityWithBodySources::UpdateWithBodies(const std::vector<HydroRod>& rods,
@@ -85,49 +80,7 @@ void MobilityWithBodySources::UpdateWithBodies(const std::vector<HydroRod>& rods
     for (int i = 0; i < num_body_points_; ++i)
       body_block_.block<3, 3>(3 * i, 3 * j) =
           scale * PointBlobMatrix(nullptr, points_.col(i), points_.col(j), point_eps_(j));
-  FindNearBlocks();
-}
-
-// For each body point, the segments whose δ = √(d² + ε²)/L is below the split's near radius:
-// their closed forms minus the far rule (RssRowKernel), as blocks on their two nodes.
-void MobilityWithBodySources::FindNearBlocks() {
-  const double scale = 1.0 / (8.0 * kPi * params_.viscosity);
-  std::vector<RssRowKernel> kernels;
-  for (const HydroRod& rod : rods_)
-    kernels.emplace_back(*rod.x, params_.regularization * rod.radius, accuracy_,
-                         split_.gauss_points);
-  std::vector<std::vector<std::pair<int, Mat3>>> per_point(static_cast<size_t>(num_body_points_));
-#pragma omp parallel for schedule(dynamic, 8)
-  for (int t = 0; t < num_body_points_; ++t) {
-    const Vec3 p = points_.col(t);
-    double table[12];
-    for (int r = 0; r < num_rods(); ++r) {
-      const Matrix3X& x = *rods_[static_cast<size_t>(r)].x;
-      const double eps = params_.regularization * rods_[static_cast<size_t>(r)].radius;
-      for (int s = 0; s + 1 < x.cols(); ++s) {
-        const Vec3 a = x.col(s), v = x.col(s + 1) - a;
-        const double along = std::clamp((p - a).dot(v) / v.squaredNorm(), 0.0, 1.0);
-        const double d2 = (p - a - along * v).squaredNorm();
-        if (d2 + eps * eps >= split_.near_delta * split_.near_delta * v.squaredNorm()) continue;
-        kernels[static_cast<size_t>(r)].Row(p, s, 1, table);
-        kernels[static_cast<size_t>(r)].SubtractRule(p, s, 1, table);
-        for (int end = 0; end < 2; ++end) {
-          const double* e = table + 6 * end;
-          const int node = node_offset(r) + s + end;
-          Mat3 block;
-          block << e[0], e[1], e[2], e[1], e[3], e[4], e[2], e[4], e[5];
-          per_point[static_cast<size_t>(t)].emplace_back(node, (scale * inverse_voronoi_(node)) * block);
-        }
-      }
-    }
-  }
-  near_start_.assign(1, 0);
-  near_source_.clear();
-  near_block_.clear();
-  for (const auto& blocks : per_point) {
-    for (const auto& [node, block] : blocks) near_source_.push_back(node), near_block_.push_back(block);
-    near_start_.push_back(static_cast<int>(near_source_.size()));
-  }
+  rods_operator_->FindNearBlocks(points_, &near_);
 }
 
 // velocity (at the body points) += the rods' segments: the far rule at every segment, summed
@@ -165,10 +118,7 @@ void MobilityWithBodySources::AddRodsAtPoints(const VecX& force, VecX* velocity)
       const double inv3 = inv * inv * inv;
       u += (inv + eps2[k] * inv3) * strength[k] + (inv3 * r.dot(strength[k])) * r;
     }
-    u *= scale;
-    for (int k = near_start_[static_cast<size_t>(t)]; k < near_start_[static_cast<size_t>(t) + 1]; ++k)
-      u += near_block_[static_cast<size_t>(k)] * force.segment<3>(3 * near_source_[static_cast<size_t>(k)]);
-    velocity->segment<3>(3 * (m + t)) += u;
+    velocity->segment<3>(3 * (m + t)) += scale * u + near_.At(t, force);
   }
 }
 

@@ -9,7 +9,8 @@
 //   bodies ← rods  the rods' segments at the body points, as the matrix-free operator does it:
 //                  the far field by the same Gauss rule summed directly at the P points, the
 //                  segments near a point (δ below the split's near radius) by their closed forms
-//                  minus that rule, stored as 3 × 3 blocks (O(P × near segments));
+//                  minus that rule, stored as 3 × 3 blocks (O(P × near segments)), found by the
+//                  rods' operator as at its own nodes (MobilityOperator::FindNearBlocks);
 //   bodies ← bodies  dense (3P × 3P), assembled at each update;
 //   the free bodies' border, G V on their points' rows and Gᵀ f in their six rows.
 // Its accuracy is the rods' operator's: every far segment–point pair by the rule the split
@@ -24,7 +25,8 @@
 
 namespace stokesrods {
 
-/// `rods_operator`: the operator of the rods alone (it takes Update); the bodies are added here.
+/// `rods_operator`: the matrix-free operator of the rods alone (it takes Update and gives the
+/// near blocks); the bodies are added here.
 std::unique_ptr<MobilityOperator> MakeMobilityWithBodySources(
     const FluidParams& params, const MobilityOptions& options,
     std::unique_ptr<MobilityOperator> rods_operator);
