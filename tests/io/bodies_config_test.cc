@@ -79,7 +79,6 @@ TEST(BodiesConfig, BadBodiesAndWallsAreRefusedNamingTheKey) {
   ExpectError(base + body + "motion = \"free\"\ntorque = [0.0, 0.0, inf]\n", "bodies.1.torque: must be finite");
   ExpectError(base + body + "surface_points = 3\n", "bodies.1.surface_points: must be between 20");
   ExpectError(base + "[fluid]\nmodel = \"lsbt\"\n" + body, "bodies.1: bodies need fluid.model = \"rss\"");
-  ExpectError(base + "[fluid]\nmobility = \"matrix_free\"\n" + body, "fluid.mobility: \"matrix_free\" does not take bodies");
   ExpectError(base + "[wall]\nnormal = [0.0, 0.0, 0.0]\n", "case.toml: wall.normal: must not be the zero vector");
   ExpectError(base + "[wall]\nnormal = [0.0, 0.0, 1.0]\nside = 1\n", "wall.side: unknown key");
   ExpectError(base + "[fluid]\nmodel = \"rft\"\n[wall]\npoint = [0.0, 0.0, -1.0]\n",

@@ -210,6 +210,12 @@ Model BuildModel(const Config& config) {
   model.hydro.krylov_tolerance = config.fluid.krylov_tolerance;
   model.hydro.mobility.tolerance = config.fluid.far_field_tolerance;
   model.hydro.mobility.fast_sum_tolerance = config.fluid.fast_sum_tolerance;
+  // Cell bodies: the far-field sum in single precision (from 1e-4) is not linear to round-off, and
+  // on a swimming cell (free body, two flagella, h = 20 ms) Newton stalls at 2.6× its tolerance
+  // where the same sum in double converges (the 2-point rule of 1e-4 too); with bodies the sum
+  // adds up in double, at most 1e-5 (docs/performance.md).
+  if (!config.bodies.empty())
+    model.hydro.mobility.fast_sum_tolerance = std::min(config.fluid.fast_sum_tolerance, 1e-5);
   // RSS only: LSBT's dense assembly costs less than the reuse's passes over 𝕄 (measured, N = 195:
   // 5.2 ms per step without, 5.7 ms with; docs/performance.md).
   model.hydro.mobility.reuse_tolerance =

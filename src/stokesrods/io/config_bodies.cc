@@ -68,9 +68,6 @@ void ValidateBody(const Config& config, const std::string& p, const BodyConfig& 
   if (config.fluid.model != "rss")
     throw ConfigError(file, p, fmt::format("bodies need fluid.model = \"rss\" (got \"{}\")",
                                            config.fluid.model));
-  if (config.fluid.mobility == "matrix_free")
-    throw ConfigError(file, "fluid.mobility",
-                      "\"matrix_free\" does not take bodies yet; use \"dense\" or \"auto\"");
   if (config.fluid.coupling == "explicit")
     throw ConfigError(file, "fluid.coupling", "bodies need fluid.coupling = \"implicit\"");
 }

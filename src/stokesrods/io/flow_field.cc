@@ -8,6 +8,7 @@
 #include "stokesrods/io/writers.h"
 #include "stokesrods/fluid/mobility_operator.h"
 #include "stokesrods/sim/bodies.h"
+#include "stokesrods/sim/capacitance_preconditioner.h"
 #include "stokesrods/sim/hydro_coupling.h"
 #include "stokesrods/solver/gmres.h"
 
@@ -31,15 +32,21 @@ std::string WriteFlowField(const Model& model, const State& state, const FlowFie
   u.segment(3 * model.num_nodes, 3 * model.num_body_points) = BodyPointVelocities(model, state.bodies);
   // The nodal forces on the fluid at the current positions and velocities, 𝕄 F = U: a dense LU
   // while 𝕄 is dense; with the matrix-free operator GMRES, preconditioned by the rods' own
-  // self-mobilities (a dense 𝕄 of a hundred flagella would take 3 GB).
+  // self-mobilities and the bodies' bordered blocks (a dense 𝕄 of a hundred flagella would take
+  // 3 GB).
   VecX forces;
-  const std::unique_ptr<MobilityOperator> mobility =
-      MakeMobilityOperator(model.fluid, model.hydro.mobility);
+  const std::unique_ptr<MobilityOperator> mobility = MakeModelMobility(model);
   mobility->UpdateWithBodies(rods, bodies);
   if (const MatX* m = mobility->matrix()) {
     forces = m->partialPivLu().solve(u);
   } else {
-    const SelfMobilityPreconditioner blocks(*mobility);
+    // The blocks of 𝕄 itself (h = 1, no elastic part): each rod's, each body's bordered by its V.
+    std::vector<MatX> self(model.rods.size());
+    for (int r = 0; r < static_cast<int>(self.size()); ++r) self[static_cast<size_t>(r)] = mobility->SelfBlock(r);
+    CapacitancePreconditioner blocks;
+    if (!blocks.Build(model, 1.0, self, bodies, nullptr, nullptr))
+      throw IoError(fmt::format("{}: flow field not written: a block of the mobility is singular",
+                                output_dir));
     const LinearOperator apply = [&](const VecX& x, VecX* y) { mobility->Apply(x, y); };
     const LinearOperator precondition = [&](const VecX& x, VecX* y) { blocks.Apply(x, y); };
     const GmresReport g = SolveGmres(apply, precondition, u, {.tolerance = 1e-10}, &forces);

@@ -4,12 +4,13 @@
 #include <cmath>
 
 #include "stokesrods/common/assert.h"
+#include "stokesrods/fluid/mobility_sources.h"
 #include "stokesrods/sim/bodies.h"
 #include "stokesrods/sim/state.h"
+#include "stokesrods/solver/blas.h"
 #include "stokesrods/solver/gmres.h"
 
 namespace stokesrods {
-
 
 void GatherNodeVelocities(const Model& model, const VecX& q, const VecX& q_start, double h,
                           VecX* u) {
@@ -19,6 +20,12 @@ void GatherNodeVelocities(const Model& model, const VecX& q, const VecX& q_start
       const int k = rod.dof_offset + NodeDof(i);
       u->segment<3>(3 * (rod.node_offset + i)) = (q.segment<3>(k) - q_start.segment<3>(k)) / h;
     }
+}
+
+std::unique_ptr<MobilityOperator> MakeModelMobility(const Model& model) {
+  std::unique_ptr<MobilityOperator> rods = MakeMobilityOperator(model.fluid, model.hydro.mobility);
+  if (model.bodies.empty() || rods->matrix() != nullptr) return rods;
+  return MakeMobilityWithBodySources(model.fluid, model.hydro.mobility, std::move(rods));
 }
 
 std::vector<HydroRod> MakeHydroRods(const Model& model, const std::vector<Matrix3X>& positions) {
@@ -37,17 +44,16 @@ constexpr int kFullLuBelow = 3000;
 constexpr int kPreconditionerMaxAge = 20;
 
 void HydroCoupling::Init(const Model& model) {
-  mobility_ = MakeMobilityOperator(model.fluid, model.hydro.mobility);
+  mobility_ = MakeModelMobility(model);
   krylov_ = model.hydro.solver == HydroSolver::kKrylov;
   explicit_ = model.coupling == FluidCoupling::kExplicit;
-  // The whole capacitance's LU while it is small; above 3M = 3000 its O((3M)³) rebuilds cost more
-  // than the extra GMRES products of the two-level preconditioner (docs/performance.md).
-  // Bodies (dense only) keep the whole capacitance's LU: the blocks are per rod.
-  block_preconditioner_ = model.bodies.empty() &&
-      (mobility_->matrix() == nullptr || (krylov_ && 3 * model.num_nodes > kFullLuBelow));
-  SR_ASSERT(model.bodies.empty() || (!explicit_ && mobility_->matrix() != nullptr) ||
-                model.fluid.model != FluidModel::kRss,
-            "bodies need the implicit coupling and the dense mobility");
+  // The whole capacitance's LU while it is small; above 3(M + P) = 3000 its O((3(M + P))³)
+  // rebuilds cost more than the extra GMRES products of the block preconditioner
+  // (docs/performance.md).
+  block_preconditioner_ = mobility_->matrix() == nullptr ||
+                          (krylov_ && 3 * model.num_hydro_points() > kFullLuBelow);
+  SR_ASSERT(model.bodies.empty() || !explicit_ || model.fluid.model != FluidModel::kRss,
+            "bodies need the implicit coupling");
   SR_ASSERT(krylov_ || !block_preconditioner_, "the direct solve needs a dense mobility");
 }
 
@@ -145,12 +151,10 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
     BuildSchurBlocks(model);
     if (block_preconditioner_) {
       std::vector<MatX> blocks(model.rods.size());
-      block_lu_.assign(model.rods.size(), DenseLu<float>());
-      for (std::size_t r = 0; r < model.rods.size(); ++r) {
+      for (std::size_t r = 0; r < model.rods.size(); ++r)
         blocks[r] = h * mobility_->SelfBlock(static_cast<int>(r)) + sx_blocks_[r];
-        if (!block_lu_[r].Compute(blocks[r].cast<float>())) return have_preconditioner_ = false;
-      }
-      if (!BuildCoarseLevel(model, h, blocks)) return have_preconditioner_ = false;
+      if (!capacitance_blocks_.Build(model, h, blocks, bodies_, borders_, &positions_))
+        return have_preconditioner_ = false;
     } else {
       MatX capacitance = h * *mobility_->matrix();
       for (std::size_t r = 0; r < model.rods.size(); ++r) {
@@ -220,39 +224,11 @@ void HydroCoupling::ApplyCapacitance(const Model& model, double h, const VecX& v
   if (borders_) ApplyClampBorders(model, h, *borders_, v, scratch_dofs_, out);
 }
 
-bool HydroCoupling::BuildCoarseLevel(const Model& model, double h,
-                                     const std::vector<MatX>& blocks) {
-  std::vector<CoarseRod> rods(model.rods.size());
-  for (std::size_t r = 0; r < rods.size(); ++r)
-    rods[r] = {.x = &positions_[r],
-               .eps = model.fluid.regularization * model.rods[r].radius,
-               .node_offset = model.rods[r].node_offset};
-  return coarse_.Build(rods, blocks, h / (8.0 * kPi * model.fluid.viscosity));
-}
-
 void HydroCoupling::Precondition(const VecX& v, VecX* out) const {
-  if (!block_preconditioner_) {
-    Eigen::VectorXf x = v.cast<float>();
-    capacitance_lu_float_.Solve(&x);
-    *out = x.cast<double>();
-    return;
-  }
-  // Coarse: c = E⁻¹ Zᵀ v; then the blocks on what the coarse correction leaves, y = Zc + D⁻¹(v − Wc).
-  const VecX coarse = coarse_.Solve(v);
-  VecX wc;
-  coarse_.ApplyW(coarse, &wc);
-  const VecX rest = v - wc;
-  out->resize(v.size());
-  const int num_rods = mobility_->num_rods();
-#pragma omp parallel for schedule(static) if (num_rods > 1)
-  for (int r = 0; r < num_rods; ++r) {
-    const int first = 3 * mobility_->node_offset(r);
-    const int n = 3 * (mobility_->node_offset(r + 1) - mobility_->node_offset(r));
-    Eigen::VectorXf x = rest.segment(first, n).cast<float>();
-    block_lu_[static_cast<size_t>(r)].Solve(&x);
-    out->segment(first, n) = x.cast<double>();
-  }
-  coarse_.AddZ(coarse, out);
+  if (block_preconditioner_) return capacitance_blocks_.Apply(v, out);
+  Eigen::VectorXf x = v.cast<float>();
+  capacitance_lu_float_.Solve(&x);
+  *out = x.cast<double>();
 }
 
 HydroSolveReport HydroCoupling::SolveNewtonSystem(const Model& model,

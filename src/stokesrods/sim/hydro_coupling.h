@@ -12,15 +12,10 @@
 //   direct: by a dense LU of C at the current 𝕄 (the reference, refactorized whenever 𝕄 or B is),
 //   krylov: by GMRES with products h 𝕄 v + S X v (𝕄 matrix-free or dense) and a preconditioner
 //           kept across steps, rebuilt with the Newton factors or when GMRES slows:
-//           dense 𝕄: the LU of the whole C;
-//           matrix-free: two levels. Coarse (sim/coarse_level.h): per rod, K chunks of
-//           consecutive nodes with a uniform force each (columns Z, 3K per rod), the coarse
-//           operator E = Zᵀ W with W ≈ C Z (within a rod from the exact blocks, between rods
-//           a point Stokeslet at each chunk's centroid; W c a Stokeslet sum, W never stored).
-//           Fine: the LU of the per-rod blocks
-//           D_k = h 𝕄_kk + S_k X_k. One application: c = E⁻¹ Zᵀ r, y = Z c + D⁻¹ (r − W c).
-//           Block Jacobi alone misses the collective flow of many rods (GMRES then needs
-//           5–6× more products); the coarse level carries it.
+//           up to 3(M + P) = 3000 with a dense 𝕄: the LU of the whole C (single precision);
+//           else (matrix-free, or larger): blocks per rod and per body, bordered by the free
+//           bodies' motions (sim/capacitance_preconditioner.h), and a coarse level
+//           (sim/coarse_level.h: W ≈ C Z by a point Stokeslet per chunk, never stored).
 // Since r_u is linear in (q, f), after a full Newton step it is the GMRES residual / h; along a
 // damped step it changes linearly, so line-search trials need no product with 𝕄.
 #pragma once
@@ -31,8 +26,8 @@
 #include <Eigen/LU>
 
 #include "stokesrods/fluid/mobility_operator.h"
+#include "stokesrods/sim/capacitance_preconditioner.h"
 #include "stokesrods/sim/clamp_border.h"
-#include "stokesrods/sim/coarse_level.h"
 #include "stokesrods/sim/forces.h"
 #include "stokesrods/sim/model.h"
 #include "stokesrods/sim/state.h"
@@ -129,9 +124,7 @@ class HydroCoupling {
   // preconditioner needs no more, and its solves stream half the memory —, or two levels).
   Eigen::PartialPivLU<MatX> capacitance_lu_;  ///< direct: the reference, Eigen's own LU
   DenseLu<float> capacitance_lu_float_;
-  std::vector<DenseLu<float>> block_lu_;      ///< the per-rod blocks D_k (single precision)
-  bool BuildCoarseLevel(const Model& model, double h, const std::vector<MatX>& blocks);
-  CoarseLevel coarse_;             ///< of the two-level preconditioner (sim/coarse_level.h)
+  CapacitancePreconditioner capacitance_blocks_;  ///< blocks and coarse level
   bool block_preconditioner_ = false;
   int iterations_after_refresh_ = -1;
   bool have_preconditioner_ = false;
@@ -149,6 +142,10 @@ class HydroCoupling {
 /// Gathers the node velocities (x − x_start)/h of all rods into a 3M vector.
 void GatherNodeVelocities(const Model& model, const VecX& q, const VecX& q_start, double h,
                           VecX* u);
+
+/// The mobility operator of the model: model.hydro.mobility's, with the bodies' points behind a
+/// matrix-free one (fluid/mobility_sources.h).
+std::unique_ptr<MobilityOperator> MakeModelMobility(const Model& model);
 
 /// The hydrodynamic rods (positions at q) as the fluid module sees them.
 std::vector<HydroRod> MakeHydroRods(const Model& model, const std::vector<Matrix3X>& positions);
