@@ -83,6 +83,9 @@ TEST(BadInput, ZeroOrNegativeLengthsAndModuliAndTooFewNodesAreRefused) {
       {run + "[[rods]]\nshape = \"straight\"\nnodes = 2\n", "rods.1.nodes: must be between 3"},
       {run + "[[rods]]\nshape = \"points\"\npoints = [[0, 0, 0], [0, 0, -0.1]]\n",
        "rods.1.points: shape = \"points\" needs at least 3 points"},
+      // Found by the fuzzer (tests/data/fuzz/crash_points_turn_back.toml): a 180° turn.
+      {run + "[[rods]]\nshape = \"points\"\npoints = [[1, 0, 0], [0.01, 0, 0], [0.02, 0, 0]]\n",
+       "rods.1.points[2]: turns the rod back on itself"},
   });
 }
 
