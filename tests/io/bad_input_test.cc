@@ -86,6 +86,18 @@ TEST(BadInput, ZeroOrNegativeLengthsAndModuliAndTooFewNodesAreRefused) {
       // Found by the fuzzer (tests/data/fuzz/crash_points_turn_back.toml): a 180° turn.
       {run + "[[rods]]\nshape = \"points\"\npoints = [[1, 0, 0], [0.01, 0, 0], [0.02, 0, 0]]\n",
        "rods.1.points[2]: turns the rod back on itself"},
+      // Found by the fuzzer (crash_points_far_node.toml): an edge whose length overflows.
+      {run + "[[rods]]\nshape = \"points\"\npoints = [[1, 0, 0], [0.01, 0, 0], [0.02, 0, 1.1e297]]\n",
+       "rods.1.points[2]: node 2 at (0.02, 0, 1.1e+297) lies outside ±1e+100 m"},
+      // A node so far out that the edges lose their digits; the same for a generated shape.
+      {run + "[[rods]]\nshape = \"points\"\npoints = [[1, 0, 0], [0, 0, 0], [0, 0, 1e9]]\n",
+       "rods.1.points[2]: node 2 lies 1e+09 m from the origin, more than 1e+08 times edge 0 (1 m)"},
+      {run + "[[rods]]\nshape = \"straight\"\nbase = [1e30, 0, 0]\n",
+       "rods.1.base: node 0 lies 1e+30 m from the origin"},
+      {run + "[[rods]]\nshape = \"straight\"\naxis_length = 1e200\n",
+       "rods.1.axis_length: node 1 at (0, 0, -1.5625e+198) lies outside ±1e+100 m"},
+      {run + "[[rods]]\nshape = \"points\"\npoints = [[0, 0, 0], [0, 0, nan], [0, 0, 1]]\n",
+       "rods.1.points[1]: node 1 at (0, 0, nan) lies outside ±1e+100 m"},
   });
 }
 

@@ -20,27 +20,10 @@
 #include "stokesrods/sim/observables.h"
 #include "stokesrods/sim/state.h"
 #include "stokesrods/io/build_bodies.h"
+#include "stokesrods/io/rest_shape.h"
 
 namespace stokesrods {
 namespace {
-
-Matrix3X RestShape(const RodConfig& rod) {
-  if (rod.shape == "straight") return StraightNodes(rod.nodes, rod.axis_length, rod.base);
-  if (rod.shape == "points") {
-    Matrix3X x(3, static_cast<Eigen::Index>(rod.points.size()));
-    for (std::size_t i = 0; i < rod.points.size(); ++i) x.col(static_cast<Eigen::Index>(i)) = rod.points[i];
-    return x;
-  }
-  HelixGeometry g;
-  g.nodes = rod.nodes;
-  g.axis_length = rod.axis_length;
-  g.pitch = rod.pitch;
-  g.helix_radius = rod.helix_radius;
-  g.right_handed = rod.handedness == "right";
-  g.lead_in_above = rod.lead_in == "above";
-  g.base = rod.base;
-  return HelixNodes(g);
-}
 
 FluidModel ParseFluidModel(const std::string& name) {
   if (name == "rss") return FluidModel::kRss;
@@ -242,6 +225,8 @@ Model BuildModel(const Config& config) {
     rod.bending_stiffness = rc.young_modulus * inertia;
     rod.twisting_stiffness = shear * 2.0 * inertia;  // J = π r0⁴ / 2 = 2 I
     rod.rest_positions = RestShape(rc);
+    CheckRestShape(config.file, fmt::format("rods.{}", model.rods.size() + 1), rc,
+                   rod.rest_positions);
     rod.clamped_nodes = rc.clamped_nodes;
     rod.body = rc.body - 1;
     rod.axis_length = rc.axis_length;

@@ -54,15 +54,6 @@ void ValidateRod(const Checker& c, const std::string& p, RodConfig* rod) {
       if ((rod->points[i + 1] - rod->points[i]).norm() <= 0.0)
         throw ConfigError(c.file, fmt::format("{}.points[{}]", p, i + 1),
                           "repeats the previous point (zero-length edge)");
-    for (std::size_t i = 1; i + 1 < rod->points.size(); ++i) {
-      // A 180° turn has no curvature binormal (2 t0 × t1 / (1 + t0 · t1)) and no parallel
-      // transport of the frame: the edges before and after point i must not be opposite.
-      const Vec3 t0 = (rod->points[i] - rod->points[i - 1]).normalized();
-      const Vec3 t1 = (rod->points[i + 1] - rod->points[i]).normalized();
-      if (t0.dot(t1) <= -1.0 + 1e-9)
-        throw ConfigError(c.file, fmt::format("{}.points[{}]", p, i + 1),
-                          "turns the rod back on itself (a 180° turn at the previous point)");
-    }
     rod->nodes = static_cast<int>(rod->points.size());
     // l0 of a points rod: its end-to-end distance at rest (used for normalizations).
     rod->axis_length = (rod->points.back() - rod->points.front()).norm();
