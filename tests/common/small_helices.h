@@ -4,6 +4,8 @@
 
 #include <string>
 
+#include "common/cell_toml.h"
+
 namespace stokesrods::testing {
 
 /// `run_lines` and `fluid_lines` are added to [run] (after duration = 1.0) and [fluid].
@@ -13,9 +15,7 @@ inline std::string SmallHelicesToml(int rods, int nodes, double omega_bar,
   std::string text = "[run]\nduration = 1.0\n" + run_lines + "\n[fluid]\n" + fluid_lines +
                      "\n[contact]\nenabled = false\n";
   for (int r = 0; r < rods; ++r)
-    text += "[[rods]]\nnodes = " + std::to_string(nodes) +
-            "\naxis_length = 0.1\nhelix_radius = 0.008\nomega_bar = " + std::to_string(omega_bar) +
-            "\nbase = [" + std::to_string(0.0175 * r) + ", 0.0, 0.0]\n";
+    text += HelixToml(nodes, 0.0175 * r, "omega_bar = " + std::to_string(omega_bar));
   return text;
 }
 

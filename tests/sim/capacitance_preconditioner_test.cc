@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <random>
 
+#include "common/cell_toml.h"
 #include "common/model_from_toml.h"
 #include "stokesrods/sim/bodies.h"
 #include "stokesrods/sim/capacitance_preconditioner.h"
@@ -18,34 +19,11 @@
 namespace stokesrods {
 namespace {
 
-// A free cell with two helices, a fixed sphere beside it.
-constexpr const char* kCell = R"(
-[run]
-duration = 1.0
-[[bodies]]
-radius = 0.02
-center = [0.015, 0.0, 0.021]
-motion = "free"
-surface_points = 60
-[[bodies]]
-radius = 0.015
-center = [0.08, 0.0, -0.05]
-surface_points = 40
-[[rods]]
-nodes = 12
-axis_length = 0.1
-helix_radius = 0.008
-body = 1
-[[rods]]
-nodes = 12
-axis_length = 0.1
-helix_radius = 0.008
-base = [0.03, 0.0, 0.0]
-body = 1
-)";
+// The swimming cell (a free sphere with two helices) beside a fixed sphere, small.
+const testing::CellCase kCell{.nodes = 12, .cell_points = 60, .fixed_points = 40, .omega_bar = 0.0};
 
 TEST(CapacitancePreconditioner, SolvesTheBorderedBlocksAsTheirDenseLu) {
-  const Model model = testing::ModelFromToml(kCell);
+  const Model model = testing::ModelFromToml(testing::SwimmingCellToml(kCell));
   const State state = MakeRestState(model);
   const std::vector<BodySurface> bodies = BodySurfaces(model, state.bodies);
   const double h = 0.02;

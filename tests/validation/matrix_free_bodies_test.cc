@@ -2,7 +2,8 @@
 // capacitance preconditioned by blocks bordered by the free bodies' motions
 // (sim/capacitance_preconditioner.h), against the dense reference (dense 𝕄 with the bodies, the
 // capacitance by a fresh LU at every step): a swimming cell (a free sphere holding two helices,
-// their motors turning them against it) beside a fixed sphere, 10 steps of implicit Euler.
+// their motors turning them against it) beside a fixed sphere, 4 steps of implicit Euler
+// (tests/common/cell_toml.h).
 // All paths solve the same discrete equations; the fast ones stop GMRES at the Newton tolerance,
 // and the matrix-free one carries its far-field tolerance. As tests/validation/fast_path_test.cc:
 // at a far field of 1e-8 we allow 1e-6 (of the helix radius on positions, of their largest values
@@ -13,6 +14,7 @@
 #include <cstdio>
 #include <string>
 
+#include "common/cell_toml.h"
 #include "common/model_from_toml.h"
 #include "stokesrods/sim/bodies.h"
 #include "stokesrods/sim/integrator.h"
@@ -22,40 +24,11 @@ namespace {
 
 using testing::ModelFromToml;
 
-std::string Cell(const std::string& fluid) {
-  return R"(
-[run]
-duration = 1.0
-[fluid]
-model = "rss"
-)" + fluid + R"(
-[[bodies]]
-radius = 0.025
-center = [0.015, 0.0, 0.02]
-motion = "free"
-surface_points = 200
-[[bodies]]
-radius = 0.015
-center = [0.08, 0.0, -0.05]
-motion = "fixed"
-surface_points = 150
-[[rods]]
-nodes = 33
-axis_length = 0.1
-pitch = 0.05
-helix_radius = 0.008
-omega_bar = 320
-body = 1
-[[rods]]
-nodes = 33
-axis_length = 0.1
-pitch = 0.05
-helix_radius = 0.008
-omega_bar = 320
-base = [0.03, 0.0, 0.0]
-body = 1
-)";
-}
+// Small enough to take about a second: 17 nodes per helix, 80 + 40 surface points, 4 steps of
+// 20 ms (the near blocks still matter: without the rods' near blocks at the body points the
+// difference is 1.6e-2 R, checked).
+constexpr testing::CellCase kCell{.nodes = 17, .cell_points = 80, .fixed_points = 40};
+constexpr int kSteps = 4;
 
 struct Series {
   std::vector<VecX> q;         // rods' DOFs after each step
@@ -64,7 +37,7 @@ struct Series {
 };
 
 Series RunCell(const std::string& fluid, int steps, double h = 0.02) {
-  const Model model = ModelFromToml(Cell(fluid));
+  const Model model = ModelFromToml(testing::SwimmingCellToml(kCell, fluid));
   State state = MakeRestState(model);
   Workspace ws(model);
   Series s;
@@ -114,18 +87,18 @@ void Compare(const Series& ref, const Series& fast, const char* name, double tol
 }
 
 TEST(MatrixFreeBodies, SwimmingCellAsTheDenseReference) {
-  const Series ref = RunCell("mobility = \"dense\"\nsolver = \"direct\"", 10);
-  ASSERT_EQ(ref.q.size(), 10u);
-  std::printf("reference: U_z = %.4e m/s, Omega_z = %.4e rad/s after 10 steps\n", ref.body.back()(5),
-              ref.body.back()(8));
-  Compare(ref, RunCell("mobility = \"dense\"\nsolver = \"krylov\"", 10), "dense + GMRES (LU of C)",
-          1e-6);
+  const Series ref = RunCell("mobility = \"dense\"\nsolver = \"direct\"", kSteps);
+  ASSERT_EQ(ref.q.size(), static_cast<std::size_t>(kSteps));
+  std::printf("reference: U_z = %.4e m/s, Omega_z = %.4e rad/s after %d steps\n",
+              ref.body.back()(5), ref.body.back()(8), kSteps);
+  Compare(ref, RunCell("mobility = \"dense\"\nsolver = \"krylov\"", kSteps),
+          "dense + GMRES (LU of C)", 1e-6);
   Compare(ref,
           RunCell("mobility = \"matrix_free\"\nfar_field_tolerance = 1e-8\nfast_sum_tolerance = 1e-8",
-              10),
+                  kSteps),
           "matrix-free (far field 1e-8) + GMRES (bordered blocks, coarse level)", 1e-6);
   // With bodies the far-field sum runs in double, at most 1e-5 (io/build_model.cc).
-  Compare(ref, RunCell("mobility = \"matrix_free\"", 10),
+  Compare(ref, RunCell("mobility = \"matrix_free\"", kSteps),
           "matrix-free (defaults with bodies: far field 1e-5) + GMRES", 1e-5);
 }
 

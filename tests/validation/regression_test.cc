@@ -9,6 +9,7 @@
 #include <map>
 #include <sstream>
 
+#include "common/cell_toml.h"
 #include "common/model_from_toml.h"
 #include "stokesrods/sim/integrator.h"
 #include "stokesrods/sim/observables.h"
@@ -16,7 +17,7 @@
 namespace stokesrods {
 namespace {
 
-constexpr char kCase[] = R"(
+const std::string kCase = R"(
 [run]
 duration = 1.0
 time_step = 0.01
@@ -24,18 +25,8 @@ time_step = 0.01
 model = "rss"
 [contact]
 enabled = true
-[[rods]]
-nodes = 15
-axis_length = 0.1
-helix_radius = 0.008
-omega_bar = 300
-[[rods]]
-nodes = 15
-axis_length = 0.1
-helix_radius = 0.008
-base = [0.0175, 0.0, 0.0]
-omega_bar = 300
-)";
+)" + testing::HelixToml(15, 0.0, "omega_bar = 300") +
+                            testing::HelixToml(15, 0.0175, "omega_bar = 300");
 
 std::map<std::string, double> ReadReference() {
   std::ifstream in(std::string(STOKESRODS_SOURCE_DIR) + "/tests/data/regression_two_helices.csv");
