@@ -38,6 +38,13 @@ TEST(BodiesConfig, WallIsReadNormalizedAndEchoed) {
   EXPECT_EQ(again.wall->normal, c.wall->normal);
   EXPECT_NE(ConfigToJson(c).find("\"wall\""), std::string::npos);
   EXPECT_FALSE(ParseConfig(std::string(kRun) + kRod, "case.toml").wall.has_value());
+  // The matrix-free mobility takes the wall (its images as sources: fluid/wall_sources.h).
+  const Model mf = BuildModel(ParseConfig(std::string(kRun) + kRod +
+                                              "[fluid]\nmobility = \"matrix_free\"\n"
+                                              "[wall]\npoint = [0.0, 0.0, -0.2]\n",
+                                          "case.toml"));
+  EXPECT_EQ(mf.hydro.mobility.kind, MobilityKind::kMatrixFree);
+  ASSERT_TRUE(mf.fluid.wall.has_value());
 }
 
 TEST(BodiesConfig, BodiesAreReadAndEchoedWithOverrides) {
@@ -85,8 +92,6 @@ TEST(BodiesConfig, BadBodiesAndWallsAreRefusedNamingTheKey) {
               "case.toml: wall: fluid.model = \"rft\" has no wall");
   ExpectError(base + "[fluid]\nmodel = \"lsbt\"\n[wall]\npoint = [0.0, 0.0, -1.0]\n",
               "case.toml: wall: fluid.model = \"lsbt\" has no wall");
-  ExpectError(base + "[fluid]\nmobility = \"matrix_free\"\n[wall]\npoint = [0.0, 0.0, -1.0]\n",
-              "fluid.mobility: \"matrix_free\" has no wall images yet");
   ExpectError(base + "[wall]\npoint = [0.0, 0.0, -0.05]\n",
               "case.toml: rods.1.base: rod 1 crosses or touches the wall");
   ExpectError("[[rods]]\nnodes = 21\naxis_length = 0.1\nhelix_radius = 0.008\nbody = 2\n" +

@@ -214,5 +214,36 @@ enabled = true
   Compare(first, RunSeries(fmm, 10, 5), 0.01, "10 flagella, matrix-free + FMM (p = 6) + GMRES", 2e-4);
 }
 
+// A wall: the helix of examples/helix_near_wall.toml turned 2 helix radii from the plane
+// x = −0.02 m, 30 steps of 10 ms. The matrix-free operator takes the images as sources
+// (fluid/wall_sources.h); the dense reference has them in 𝕄. The wall itself moves the nodes by
+// 2.0e-4 m (2e-2 R) over these steps (the same run with the wall 10 m away), so a matrix-free
+// path without (or with wrong) images fails both comparisons.
+TEST(FastPath, HelixNearAWall) {
+  auto with = [](const std::string& fluid) {
+    return R"(
+[run]
+duration = 1.0
+[fluid]
+model = "rss"
+)" + fluid + R"(
+[[rods]]
+nodes = 65
+pitch = 0.05
+helix_radius = 0.01
+clamped_nodes = 2
+omega_bar = 533
+[wall]
+point = [-0.02, 0.0, 0.0]
+normal = [1.0, 0.0, 0.0]
+)";
+  };
+  const Series ref = RunSeries(with("mobility = \"dense\"\nsolver = \"direct\""), 30, 10);
+  Compare(ref, RunSeries(with(kStrictMatrixFree), 30, 10), 0.01,
+          "helix near a wall, matrix-free (far field 1e-8) + GMRES");
+  Compare(ref, RunSeries(with("mobility = \"matrix_free\""), 30, 10), 0.01,
+          "helix near a wall, matrix-free (defaults: far field 1e-4) + GMRES", kDefaultFarField);
+}
+
 }  // namespace
 }  // namespace stokesrods

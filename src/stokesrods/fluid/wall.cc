@@ -41,22 +41,29 @@ SegmentMobility StokesletSegmentNearWall(const Wall& wall, const Vec3& xa, const
   return out;
 }
 
-SegmentMobility StokesletSegmentWallImages(const Wall& wall, const Vec3& xa, const Vec3& xb,
-                                           double regularization, const Vec3& point) {
-  SegmentMobility out;
-  const Vec3 v = xb - xa;
-  const double length = v.norm();
-  // The mirrored segment and the target's distance to it.
+namespace {
+
+// Where the images' part of a segment is singular: the mirrored segment. Returns the distance
+// √(d*² + ε²) from `point` to it.
+double MirrorDistance(const Wall& wall, const Vec3& xa, const Vec3& xb, double regularization,
+                      const Vec3& point) {
   auto mirror = [&](const Vec3& y) { return Vec3(y - 2.0 * (y - wall.point).dot(wall.normal) * wall.normal); };
   const Vec3 ma = mirror(xa), mv = mirror(xb) - ma;
   const double t = std::clamp((point - ma).dot(mv) / mv.squaredNorm(), 0.0, 1.0);
-  const double distance = std::hypot((point - ma - t * mv).norm(), regularization);
-  const int panels = std::max(1, static_cast<int>(std::ceil(length / distance)));
+  return std::hypot((point - ma - t * mv).norm(), regularization);
+}
+
+// L ∫ φ(α) (W − S_ε)(x̂, x_α) dα by an n-point Gauss–Legendre rule on `panels` equal panels.
+SegmentMobility ImagesByGauss(const Wall& wall, const Vec3& xa, const Vec3& xb,
+                              double regularization, const Vec3& point, int n, int panels) {
+  SegmentMobility out;
+  const Vec3 v = xb - xa;
+  const double length = v.norm();
   const double* nodes = nullptr;
   const double* weights = nullptr;
-  GaussLegendreRule01(20, &nodes, &weights);
+  GaussLegendreRule01(n, &nodes, &weights);
   for (int p = 0; p < panels; ++p)
-    for (int q = 0; q < 20; ++q) {
+    for (int q = 0; q < n; ++q) {
       const double alpha = (p + nodes[q]) / panels, w = weights[q] * length / panels;
       const Vec3 y = xa + alpha * v;
       const Mat3 image = RegularizedBlakeletMatrix(wall, point, y, regularization) -
@@ -65,6 +72,30 @@ SegmentMobility StokesletSegmentWallImages(const Wall& wall, const Vec3& xa, con
       out.b += w * alpha * image;
     }
   return out;
+}
+
+}  // namespace
+
+SegmentMobility StokesletSegmentWallImages(const Wall& wall, const Vec3& xa, const Vec3& xb,
+                                           double regularization, const Vec3& point) {
+  // 20 points on panels no longer than the distance to the mirrored segment.
+  const double distance = MirrorDistance(wall, xa, xb, regularization, point);
+  const int panels = std::max(1, static_cast<int>(std::ceil((xb - xa).norm() / distance)));
+  return ImagesByGauss(wall, xa, xb, regularization, point, 20, panels);
+}
+
+SegmentMobility StokesletSegmentWallImagesGauss(const Wall& wall, const Vec3& xa, const Vec3& xb,
+                                                double regularization, const Vec3& point, int n) {
+  return ImagesByGauss(wall, xa, xb, regularization, point, n, 1);
+}
+
+double WallImageDelta(const Wall& wall, const Vec3& xa, const Vec3& xb, double regularization,
+                      const Vec3& point) {
+  return MirrorDistance(wall, xa, xb, regularization, point) / (xb - xa).norm();
+}
+
+double WallImageRuleError(int n, double delta) {
+  return 2.0 * 2.2e-2 * std::pow(11.5, -(n - 2.0)) * std::pow(std::max(delta, 1.0), -(2.0 * n - 2.0));
 }
 
 Mat3 PointBlobMatrix(const Wall* wall, const Vec3& x, const Vec3& x0, double regularization) {

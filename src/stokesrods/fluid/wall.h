@@ -44,6 +44,22 @@ SegmentMobility StokesletSegmentNearWall(const Wall& wall, const Vec3& xa, const
 SegmentMobility StokesletSegmentWallImages(const Wall& wall, const Vec3& xa, const Vec3& xb,
                                            double regularization, const Vec3& point);
 
+/// The images' part by an n-point Gauss–Legendre rule on the whole segment (1 ≤ n ≤ 20): the far
+/// rule of the matrix-free wall (fluid/wall_sources.h).
+SegmentMobility StokesletSegmentWallImagesGauss(const Wall& wall, const Vec3& xa, const Vec3& xb,
+                                                double regularization, const Vec3& point, int n);
+
+/// δ* = √(d*² + ε²)/L of the images' part: d* the distance from `point` to the mirrored segment,
+/// where the images are singular (the free part's δ with the segment mirrored) [–].
+double WallImageDelta(const Wall& wall, const Vec3& xa, const Vec3& xb, double regularization,
+                      const Vec3& point);
+
+/// Bound on the relative error (Frobenius, of (A_a, A_b) of the images' part) of the n-point rule
+/// at δ* ≥ 1: twice the measured worst case e*_n(δ*) ≈ c*_n δ*^−(2n−2), c*_n ≈ 2.2e-2 ·
+/// 11.5^−(n−2) (one power of δ* slower than the free part's rule: the images hold doublets and
+/// dipoles; calibration in tests/fluid/wall_sources_test.cc) [–].
+double WallImageRuleError(int n, double delta);
+
 /// 8πμ times the mobility of a point blob at x0 seen at x: the regularized Stokeslet, or with a
 /// `wall` (may be null) the Blakelet above [1/m].
 Mat3 PointBlobMatrix(const Wall* wall, const Vec3& x, const Vec3& x0, double regularization);

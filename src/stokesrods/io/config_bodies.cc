@@ -87,10 +87,6 @@ void ValidateWall(Config* config) {
                                   "regularized images of fluid.model = \"rss\" (no wall "
                                   "correction of LSBT or RFT, no wall contact yet)",
                                   model));
-  if (config->fluid.mobility == "matrix_free")
-    throw ConfigError(file, "fluid.mobility",
-                      "\"matrix_free\" has no wall images yet; with a [wall] use \"dense\" or "
-                      "\"auto\" (which then stays dense)");
 }
 
 }  // namespace

@@ -32,7 +32,7 @@ const std::map<std::string, std::string>& Meanings() {
       {"fluid.viscosity", "μ [Pa·s]"},
       {"fluid.regularization", "RSS blob size ε in units of the rod radius r0"},
       {"fluid.coupling", "\"implicit\": the drag solved with the step (stable at any h); \"explicit\": the paper's Algorithm 1 (drag from the last step; stable only below h ≈ 2m/c, refused above)"},
-      {"fluid.mobility", "\"auto\" (dense up to 500 nodes, and with bodies or a wall), \"dense\" or \"matrix_free\" (RSS only; takes bodies, no wall)"},
+      {"fluid.mobility", "\"auto\" (dense up to 500 nodes, and with bodies or a wall), \"dense\" or \"matrix_free\" (RSS only; takes bodies and a wall)"},
       {"fluid.far_field_tolerance", "dense Krylov path: relative error of one far segment–node interaction; matrix-free: the far field is accurate to the larger of this and fast_sum_tolerance"},
       {"fluid.fast_sum_tolerance", "matrix-free: error bound of the far-field sum at every size (sets the FMM's expansion order, single precision from 1e-4, with bodies at most 1e-5 in double; the FMM runs only where it pays, from about 20 flagella)"},
       {"fluid.mobility_reuse_tolerance", "dense RSS mobility: 𝕄 is extrapolated from its last two assemblies between steps while its measured relative error (Frobenius) stays below this; 0 assembles it at every step; summary.json mobility_reuse"},
@@ -84,7 +84,7 @@ const std::map<std::string, std::string>& Meanings() {
       {"bodies.torque", "a constant torque [N·m] on the body about its centre, motion = \"free\" only"},
       {"bodies.surface_points", "regularized Stokeslets on the surface (Fibonacci points, ε = 0.3 × their spacing; drag ~1.4 % low at 400, first order)"},
       {"wall.point", "a point of the plane no-slip wall [m]"},
-      {"wall.normal", "its normal, pointing into the fluid (normalized); RSS only, dense mobility only"},
+      {"wall.normal", "its normal, pointing into the fluid (normalized); RSS only (dense or matrix-free mobility)"},
   };
   return m;
 }

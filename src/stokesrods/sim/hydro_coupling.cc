@@ -5,6 +5,7 @@
 
 #include "stokesrods/common/assert.h"
 #include "stokesrods/fluid/mobility_sources.h"
+#include "stokesrods/fluid/wall_sources.h"
 #include "stokesrods/sim/bodies.h"
 #include "stokesrods/sim/state.h"
 #include "stokesrods/solver/blas.h"
@@ -23,9 +24,16 @@ void GatherNodeVelocities(const Model& model, const VecX& q, const VecX& q_start
 }
 
 std::unique_ptr<MobilityOperator> MakeModelMobility(const Model& model) {
-  std::unique_ptr<MobilityOperator> rods = MakeMobilityOperator(model.fluid, model.hydro.mobility);
-  if (model.bodies.empty() || rods->matrix() != nullptr) return rods;
-  return MakeMobilityWithBodySources(model.fluid, model.hydro.mobility, std::move(rods));
+  // The dense 𝕄 holds the bodies and the wall's images; the matrix-free rods take them as
+  // further sources around the free-space operator (the wall's images of every source last).
+  FluidParams free_space = model.fluid;
+  free_space.wall.reset();
+  std::unique_ptr<MobilityOperator> op = MakeMobilityOperator(free_space, model.hydro.mobility);
+  if (op->matrix() != nullptr) return MakeMobilityOperator(model.fluid, model.hydro.mobility);
+  if (!model.bodies.empty())
+    op = MakeMobilityWithBodySources(free_space, model.hydro.mobility, std::move(op));
+  if (model.fluid.wall) op = MakeMobilityWithWallImages(model.fluid, model.hydro.mobility, std::move(op));
+  return op;
 }
 
 std::vector<HydroRod> MakeHydroRods(const Model& model, const std::vector<Matrix3X>& positions) {
