@@ -13,8 +13,8 @@
 //                Gauss–Legendre rule whose point Stokeslets are summed by a fast summation
 //                (stokeslet_sum.h). O(M) memory.
 // Further sources of flow extend the node set and the kernel behind the same interface: a wall's
-// images are in the kernel (FluidParams::wall, dense only), cell bodies' surface points follow
-// the rods' nodes in F and U (UpdateWithBodies; dense, or the
+// images are in the kernel (FluidParams::wall, dense; matrix-free: fluid/wall_sources.h), cell
+// bodies' surface points follow the rods' nodes in F and U (UpdateWithBodies; dense, or the
 // matrix-free operator wrapped by fluid/mobility_sources.h).
 #pragma once
 

@@ -15,7 +15,7 @@
 //   the free bodies' border, G V on their points' rows and Gᵀ f in their six rows.
 // Its accuracy is the rods' operator's: every far segment–point pair by the rule the split
 // chooses for max(tolerance, fast_sum_tolerance) (tests/fluid/mobility_sources_test.cc: against
-// the dense bordered mobility). No wall: the images stay with the dense operator.
+// the dense bordered mobility). No wall here: its images are wrapped around it (wall_sources.h).
 #pragma once
 
 #include <memory>
