@@ -33,6 +33,20 @@ def run_case(config, out, overrides, skip_done=True):
         return json.load(f)
 
 
+def timed_run(binary, config_path, run_dir):
+    """One run of `binary` on one thread under /usr/bin/time (the bench scripts): returns its CPU
+    seconds (user + system), peak RSS [MB] and summary.json; exits naming the config on failure."""
+    env = dict(os.environ, OMP_NUM_THREADS="1")
+    timed = subprocess.run(["/usr/bin/time", "-f", "%U %S %M", binary, "run", str(config_path),
+                            "--output", str(run_dir)], env=env, capture_output=True, text=True)
+    if timed.returncode != 0:
+        sys.exit(f"{config_path}: exit {timed.returncode}\n{timed.stderr[-2000:]}")
+    user, system, rss_kb = timed.stderr.strip().splitlines()[-1].split()
+    with open(os.path.join(run_dir, "summary.json")) as f:
+        summary = json.load(f)
+    return float(user) + float(system), int(rss_kb) / 1024.0, summary
+
+
 def run_all(cases):
     """cases: [(config, out, overrides)]; runs them JOBS at a time; returns the summaries."""
     for _, out, _ in cases:

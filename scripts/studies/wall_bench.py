@@ -12,13 +12,11 @@ memory (max RSS) is that of the longer run.
 Prints a Markdown table (docs/performance.md, "The wall behind the matrix-free operator").
 """
 import argparse
-import json
 import math
-import os
 import pathlib
-import subprocess
-import sys
 import tempfile
+
+from common import timed_run
 
 ROD = """
 [[rods]]
@@ -50,14 +48,7 @@ def run(binary, flagella, steps, mobility, out):
     path = pathlib.Path(out) / f"{name}.toml"
     path.write_text(config(flagella, steps, mobility))
     run_dir = pathlib.Path(out) / name
-    env = dict(os.environ, OMP_NUM_THREADS="1")
-    timed = subprocess.run(["/usr/bin/time", "-f", "%U %S %M", binary, "run", str(path),
-                            "--output", str(run_dir)], env=env, capture_output=True, text=True)
-    if timed.returncode != 0:
-        sys.exit(f"{path}: exit {timed.returncode}\n{timed.stderr[-2000:]}")
-    user, system, rss_kb = timed.stderr.strip().splitlines()[-1].split()
-    summary = json.loads((run_dir / "summary.json").read_text())
-    return float(user) + float(system), int(rss_kb) / 1024.0, summary
+    return timed_run(binary, path, run_dir)
 
 
 def main():
