@@ -6,6 +6,11 @@ frames) to the body's centre; the wall's normal is +x, so the heading's angle ab
 theta = atan2(-a_y, a_z) (a rotation by theta about x takes +z to (0, -sin, cos)) and the circling
 rate is d(theta)/dt, positive counterclockwise seen from the fluid (right-handed about +x), by a least-squares line over [T0, end]. Also the gap's mean rate of change
 (body centre's x velocity) over the same window.
+The heading wobbles with the body's rotation (period T = 2 pi / |mean Omega_z|, about 16 s): the
+line over a window of about one period carries part of the wobble. When the run is long enough the
+rate is also given as the difference of theta's means over one period at the window's start and
+end, which cancels a periodic wobble: (<theta>[t1, t1 + T] - <theta>[T0, T0 + T]) / (t1 - T0),
+t1 = end - T.
 
     near_wall_circling.py RUN_DIR... [--from T0]
 
@@ -59,7 +64,17 @@ def measure(run_dir, t0):
             phis[k] += 2 * math.pi
     u = fit_slope([float(r["time"]) for r in rows if float(r["time"]) >= t0],
                   [float(r["body1_z"]) for r in rows if float(r["time"]) >= t0])
-    return fit_slope(ts, phis), fit_slope(ts, xs), u, ts[-1]
+    window = [float(r["time"]) for r in rows if float(r["time"]) >= t0]
+    omega = sum(float(r["body1_omega_z"]) for r in rows if float(r["time"]) >= t0) / len(window)
+    period = 2 * math.pi / abs(omega)
+    turn_rate = float("nan")
+    t1 = ts[-1] - period
+    if t1 > t0 + 1.0:
+        def mean_over(a):
+            values = [p for t, p in zip(ts, phis) if a <= t <= a + period]
+            return sum(values) / len(values)
+        turn_rate = (mean_over(t1) - mean_over(t0)) / (t1 - t0)
+    return fit_slope(ts, phis), turn_rate, period, fit_slope(ts, xs), u, ts[-1]
 
 
 def main():
@@ -67,12 +82,13 @@ def main():
     parser.add_argument("runs", nargs="+")
     parser.add_argument("--from", dest="t0", type=float, default=5.0)
     args = parser.parse_args()
-    print("| run | window [s] | circling rate [rad/s] | gap rate dx/dt [m/s] | U_z [m/s] |")
-    print("|---|---|---|---|---|")
+    print("| run | window [s] | circling rate, line [rad/s] | one-turn means [rad/s] | "
+          "turn T [s] | gap rate dx/dt [m/s] | U_z [m/s] |")
+    print("|---|---|---|---|---|---|---|")
     for run_dir in args.runs:
-        rate, drift, u, end = measure(run_dir, args.t0)
+        rate, turn_rate, period, drift, u, end = measure(run_dir, args.t0)
         print(f"| {run_dir.rstrip('/').split('/')[-1]} | {args.t0:g}-{end:g} | {rate:.4e} | "
-              f"{drift:.3e} | {u:.4e} |")
+              f"{turn_rate:.4e} | {period:.1f} | {drift:.3e} | {u:.4e} |")
 
 
 if __name__ == "__main__":

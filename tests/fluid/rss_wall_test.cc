@@ -81,6 +81,32 @@ TEST(RssWall, AssembledMobilityEqualsTheSegmentBySegmentReference) {
   EXPECT_LT((m - reference).norm(), 1e-12 * reference.norm());
 }
 
+// The images to a tolerance (the Krylov path's far_field_tolerance): each pair by the fewest Gauss
+// points whose WallImageRuleError meets it. The images' part (with the wall minus without, both at
+// the same tolerance) against the round-off one, Frobenius, relative to it: below the tolerance.
+TEST(RssWall, ImagesToATolerance) {
+  const Wall wall = TiltedWall();
+  const Matrix3X a = Helix(Vec3(0, 0, 0.02), Vec3(1, 0, 0), 0.01, 0.05, 1.0, 21);
+  const Matrix3X b = Helix(Vec3(0, 0.03, 0.03), Vec3(0, 1, 0.2).normalized(), 0.008, 0.04, 1.0, 17);
+  const std::vector<HydroRod> rods = {{&a, 1e-3}, {&b, 8e-4}};
+  auto images = [&](double tolerance) {
+    FluidParams params = WallParams(wall);
+    params.far_field_tolerance = tolerance;
+    MatX with, without;
+    AssembleMobility(params, rods, &with);
+    params.wall.reset();
+    AssembleMobility(params, rods, &without);
+    return MatX(with - without);
+  };
+  const MatX exact = images(0.0);
+  for (const double tolerance : {1e-8, 1e-5}) {
+    const double error = (images(tolerance) - exact).norm() / exact.norm();
+    std::printf("  tolerance %.0e: images' relative error %.2e\n", tolerance, error);
+    EXPECT_LT(error, tolerance);
+    EXPECT_GT(error, 0.0);  // fewer points were taken
+  }
+}
+
 TEST(RssWall, TheSolvedFlowVanishesOnTheWall) {
   const Wall wall = TiltedWall();
   const Matrix3X x = Helix(Vec3(0, 0, 0.0), Vec3(1, 0, 0), 0.01, 0.05, 2.0, 41);

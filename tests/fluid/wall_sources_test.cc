@@ -30,7 +30,7 @@ TEST(WallImages, RuleErrorIsBoundedByItsCalibration) {
   const Wall wall;  // z = 0
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> sym(-1.0, 1.0), unit(0.0, 1.0);
-  for (int n = 2; n <= 5; ++n) {
+  for (int n = 2; n <= kWallImageRuleMaxPoints; ++n) {
     double worst = 0.0;  // error / bound
     for (const double delta : {1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0}) {
       for (int trial = 0; trial < 300; ++trial) {

@@ -15,7 +15,8 @@ MatX RssWallImageRow(const FluidParams& params, const std::vector<HydroRod>& rod
     const VecX lengths = VoronoiLengths(*rod.x);
     for (Eigen::Index j = 0; j + 1 < rod.x->cols(); ++j) {
       const SegmentMobility s =
-          StokesletSegmentWallImages(*params.wall, rod.x->col(j), rod.x->col(j + 1), eps, point);
+          StokesletSegmentWallImages(*params.wall, rod.x->col(j), rod.x->col(j + 1), eps, point,
+                                     params.far_field_tolerance);
       row.middleCols<3>(3 * (first + j)) += scale / lengths(j) * s.a;
       row.middleCols<3>(3 * (first + j + 1)) += scale / lengths(j + 1) * s.b;
     }

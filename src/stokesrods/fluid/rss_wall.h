@@ -11,7 +11,9 @@
 
 namespace stokesrods {
 
-/// mobility += the images' part of 𝕄 = A Λ⁻¹ (3M × 3M) for params.wall [m/(N·s)].
+/// mobility += the images' part of 𝕄 = A Λ⁻¹ (3M × 3M) for params.wall [m/(N·s)]; each
+/// segment–node pair to params.far_field_tolerance as the free part (0: round-off).
+/// (StokesletSegmentWallImages with that tolerance; the rows below too.)
 void AddRssWallImages(const FluidParams& params, const std::vector<HydroRod>& rods,
                       MatX* mobility);
 

@@ -77,9 +77,15 @@ SegmentMobility ImagesByGauss(const Wall& wall, const Vec3& xa, const Vec3& xb,
 }  // namespace
 
 SegmentMobility StokesletSegmentWallImages(const Wall& wall, const Vec3& xa, const Vec3& xb,
-                                           double regularization, const Vec3& point) {
-  // 20 points on panels no longer than the distance to the mirrored segment.
+                                           double regularization, const Vec3& point,
+                                           double tolerance) {
   const double distance = MirrorDistance(wall, xa, xb, regularization, point);
+  // The fewest points of the calibrated range whose error bound meets the tolerance, if any.
+  if (tolerance > 0.0)
+    for (int n = 2; n <= kWallImageRuleMaxPoints; ++n)
+      if (WallImageRuleError(n, distance / (xb - xa).norm()) <= tolerance)
+        return ImagesByGauss(wall, xa, xb, regularization, point, n, 1);
+  // 20 points on panels no longer than the distance to the mirrored segment.
   const int panels = std::max(1, static_cast<int>(std::ceil((xb - xa).norm() / distance)));
   return ImagesByGauss(wall, xa, xb, regularization, point, 20, panels);
 }

@@ -40,9 +40,14 @@ SegmentMobility StokesletSegmentNearWall(const Wall& wall, const Vec3& xa, const
                                          double regularization, const Vec3& point);
 
 /// The images' part alone (StokesletSegmentNearWall minus StokesletSegment): what a wall adds to
-/// the free-space segment mobility.
+/// the free-space segment mobility. With `tolerance` > 0, the fewest Gauss–Legendre points on the
+/// whole segment (2 … kWallImageRuleMaxPoints) whose WallImageRuleError meets it, when some do.
 SegmentMobility StokesletSegmentWallImages(const Wall& wall, const Vec3& xa, const Vec3& xb,
-                                           double regularization, const Vec3& point);
+                                           double regularization, const Vec3& point,
+                                           double tolerance = 0.0);
+
+/// The most points WallImageRuleError is calibrated for.
+inline constexpr int kWallImageRuleMaxPoints = 5;
 
 /// The images' part by an n-point Gauss–Legendre rule on the whole segment (1 ≤ n ≤ 20): the far
 /// rule of the matrix-free wall (fluid/wall_sources.h).
