@@ -12,7 +12,7 @@ rate is also given as the difference of theta's means over one period at the win
 end, which cancels a periodic wobble: (<theta>[t1, t1 + T] - <theta>[T0, T0 + T]) / (t1 - T0),
 t1 = end - T.
 
-    near_wall_circling.py RUN_DIR... [--from T0]
+    near_wall_circling.py RUN_DIR... [--from T0] [--until T1]
 
 Prints a Markdown table (docs/validation.md, the near-wall swimming cell).
 """
@@ -38,8 +38,9 @@ def fit_slope(t, y):
     return sum((a - mt) * (b - my) for a, b in zip(t, y)) / sum((a - mt) ** 2 for a in t)
 
 
-def measure(run_dir, t0):
-    rows = list(csv.DictReader(open(f"{run_dir}/timeseries.csv")))
+def measure(run_dir, t0, t_end=math.inf):
+    rows = [r for r in csv.DictReader(open(f"{run_dir}/timeseries.csv"))
+            if float(r["time"]) <= t_end + 1e-9]
     frames = sorted(glob.glob(f"{run_dir}/frames/rods_*.vtp"))
     pvd = open(f"{run_dir}/rods.pvd").read()
     times = [float(t) for t in re.findall(r'timestep="([^"]+)"', pvd)]
@@ -49,7 +50,7 @@ def measure(run_dir, t0):
     ts, phis, xs = [], [], []
     for t, f in zip(times, frames):
         row = by_time.get(round(t, 6))
-        if row is None or t < t0:
+        if row is None or t < t0 or t > t_end + 1e-9:
             continue
         c = [float(row[f"body1_{k}"]) for k in "xyz"]
         g = frame_centroid(f)
@@ -81,12 +82,13 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("runs", nargs="+")
     parser.add_argument("--from", dest="t0", type=float, default=5.0)
+    parser.add_argument("--until", dest="t1", type=float, default=math.inf)
     args = parser.parse_args()
     print("| run | window [s] | circling rate, line [rad/s] | one-turn means [rad/s] | "
           "turn T [s] | gap rate dx/dt [m/s] | U_z [m/s] |")
     print("|---|---|---|---|---|---|---|")
     for run_dir in args.runs:
-        rate, turn_rate, period, drift, u, end = measure(run_dir, args.t0)
+        rate, turn_rate, period, drift, u, end = measure(run_dir, args.t0, args.t1)
         print(f"| {run_dir.rstrip('/').split('/')[-1]} | {args.t0:g}-{end:g} | {rate:.4e} | "
               f"{turn_rate:.4e} | {period:.1f} | {drift:.3e} | {u:.4e} |")
 
