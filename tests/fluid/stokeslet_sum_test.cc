@@ -244,6 +244,18 @@ TEST(StokesletSumTest, SinglePrecisionDirectSumIsWellWithinItsTolerance) {
   }
 }
 
+// Σ |S(x − y_s)|₂ |g_s| over [begin, end) of an S × 7 source matrix, bounded by
+// Σ (2/R + ε²/R³) |g_s|: the scale of a sum's rounding.
+double SumScale(const MatX& src, Eigen::Index begin, Eigen::Index end, const Vec3& x) {
+  double scale = 0.0;
+  for (Eigen::Index s = begin; s < end; ++s) {
+    const Vec3 r = x - src.row(s).head<3>().transpose();
+    const double big_r = std::sqrt(r.squaredNorm() + src(s, 3));
+    scale += (2.0 / big_r + src(s, 3) / std::pow(big_r, 3)) * src.row(s).tail<3>().norm();
+  }
+  return scale;
+}
+
 // The near field's kernel over several ranges of whole blocks, with padding sources of zero
 // strength as the FMM lays them out, against the plain loop over the real sources in double:
 // within float rounding (1e-6 relative to Σ|S||g|, well under kSinglePrecisionTolerance).
@@ -271,17 +283,47 @@ TEST(StokesletSumTest, BlockKernelOverRangesMatchesThePlainSum) {
   for (int trial = 0; trial < 20; ++trial) {
     const Vec3 x(unit(rng), unit(rng), unit(rng));
     const Eigen::Vector3f xf = x.cast<float>();
-    double w[3] = {0.0, 0.0, 0.0}, ref[3] = {0.0, 0.0, 0.0};
+    double w[3] = {0.0, 0.0, 0.0}, portable[3] = {0.0, 0.0, 0.0}, ref[3] = {0.0, 0.0, 0.0};
     AddPointSumBlocks(ColumnsF(padded), ranges.data(), static_cast<int>(ranges.size()), xf.data(), w);
+    PointSumBlocksPortable(ColumnsF(padded), ranges.data(), static_cast<int>(ranges.size()),
+                           xf.data(), portable);
     const Vec3 xd = xf.cast<double>();
     AddPointSum(Columns(real), 0, real.rows(), xd.data(), ref);
-    double scale = 0.0;  // Σ |S(x − y_s)|₂ |g_s| ≤ Σ (2/R + ...) |g_s|: bounded by (1/R + ε²/R³ + 1/R) |g|
-    for (Eigen::Index s = 0; s < real.rows(); ++s) {
-      const Vec3 r = xd - real.row(s).head<3>().transpose();
-      const double big_r = std::sqrt(r.squaredNorm() + real(s, 3));
-      scale += (2.0 / big_r + real(s, 3) / std::pow(big_r, 3)) * real.row(s).tail<3>().norm();
+    const double scale = SumScale(real, 0, real.rows(), xd);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(w[c], ref[c], 1e-6 * scale) << trial;
+      EXPECT_NEAR(portable[c], ref[c], 1e-6 * scale) << trial;
     }
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(w[c], ref[c], 1e-6 * scale) << trial;
+  }
+}
+
+// The single-precision kernel over ranges that are not whole blocks (the AVX-512 path masks the
+// last block; the portable loop has a remainder), against the plain loop in double.
+TEST(StokesletSumTest, SingleKernelOverAnyRangeMatchesThePlainSum) {
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> unit(-0.1, 0.1), size(0.5e-3, 2e-3);
+  MatX real(53, 7);
+  for (Eigen::Index s = 0; s < real.rows(); ++s) {
+    const double eps = size(rng);
+    real.row(s) << unit(rng), unit(rng), unit(rng), eps * eps, unit(rng), unit(rng), unit(rng);
+  }
+  const Eigen::MatrixXf single = real.cast<float>();
+  real = single.cast<double>();  // the same rounded points
+  for (const auto& [begin, end] : {std::pair{0, 53}, std::pair{3, 40}, std::pair{16, 32},
+                                   std::pair{5, 6}, std::pair{7, 7}}) {
+    for (int trial = 0; trial < 5; ++trial) {
+      const Eigen::Vector3f xf = Vec3(unit(rng), unit(rng), unit(rng)).cast<float>();
+      double w[3] = {0.0, 0.0, 0.0}, portable[3] = {0.0, 0.0, 0.0}, ref[3] = {0.0, 0.0, 0.0};
+      AddPointSumSingle(ColumnsF(single), begin, end, xf.data(), w);
+      PointSumSinglePortable(ColumnsF(single), begin, end, xf.data(), portable);
+      const Vec3 xd = xf.cast<double>();
+      AddPointSum(Columns(real), begin, end, xd.data(), ref);
+      const double scale = SumScale(real, begin, end, xd);
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(w[c], ref[c], 1e-6 * scale) << begin << " " << end;
+        EXPECT_NEAR(portable[c], ref[c], 1e-6 * scale) << begin << " " << end;
+      }
+    }
   }
 }
 

@@ -49,6 +49,13 @@ struct SourceRange {
 void AddPointSumBlocks(const SourceColumnsF& c, const SourceRange* ranges, int count,
                        const float* x, double* w);
 
+/// The compiler-vectorized loops behind AddPointSumSingle and AddPointSumBlocks on CPUs without
+/// AVX-512 (there the sums run on intrinsics; the tests check both against the double sum).
+void PointSumSinglePortable(const SourceColumnsF& c, Eigen::Index begin, Eigen::Index end,
+                            const float* x, double* w);
+void PointSumBlocksPortable(const SourceColumnsF& c, const SourceRange* ranges, int count,
+                            const float* x, double* w);
+
 /// The columns of an S × 7 single-precision source matrix.
 SourceColumnsF ColumnsF(const Eigen::MatrixXf& src);
 

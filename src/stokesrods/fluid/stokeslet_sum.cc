@@ -8,6 +8,10 @@
 
 #include <cmath>
 
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
 #include "stokesrods/common/assert.h"
 #include "stokesrods/fluid/point_stokeslet.h"
 
@@ -43,9 +47,10 @@ SourceColumnsF ColumnsF(const Eigen::MatrixXf& src) {
           src.col(4).data(), src.col(5).data(), src.col(6).data()};
 }
 
-__attribute__((target_clones("avx512f", "avx2", "default")))
-void AddPointSumSingle(const SourceColumnsF& c, Eigen::Index begin, Eigen::Index end,
-                       const float* x, double* w) {
+// The portable float loops, vectorized by the compiler (AVX2 clone chosen at run time).
+__attribute__((target_clones("avx2", "default")))
+void PointSumSinglePortable(const SourceColumnsF& c, Eigen::Index begin, Eigen::Index end,
+                            const float* x, double* w) {
   const float *sx = c.x, *sy = c.y, *sz = c.z, *se2 = c.e2, *gx = c.gx, *gy = c.gy, *gz = c.gz;
   const float px = x[0], py = x[1], pz = x[2];
   float wx = 0.0f, wy = 0.0f, wz = 0.0f;
@@ -65,9 +70,9 @@ void AddPointSumSingle(const SourceColumnsF& c, Eigen::Index begin, Eigen::Index
   w[2] += wz;
 }
 
-__attribute__((target_clones("avx512f", "avx2", "default")))
-void AddPointSumBlocks(const SourceColumnsF& c, const SourceRange* ranges, int count,
-                       const float* x, double* w) {
+__attribute__((target_clones("avx2", "default")))
+void PointSumBlocksPortable(const SourceColumnsF& c, const SourceRange* ranges, int count,
+                            const float* x, double* w) {
   constexpr int kLanes = kPointSumBlock;
   const float *sx = c.x, *sy = c.y, *sz = c.z, *se2 = c.e2, *gx = c.gx, *gy = c.gy, *gz = c.gz;
   const float px = x[0], py = x[1], pz = x[2];
@@ -94,6 +99,78 @@ void AddPointSumBlocks(const SourceColumnsF& c, const SourceRange* ranges, int c
   w[0] += sum_x;
   w[1] += sum_y;
   w[2] += sum_z;
+}
+
+namespace {
+
+#if defined(__x86_64__)
+// The same float sum written with AVX-512 intrinsics: the same arithmetic (IEEE square root and
+// division, no approximate reciprocal) with fused multiply–adds and the 16 lanes kept in
+// registers. GCC 12 vectorizes the portable loop into code 18 % slower (measured, AMD EPYC, one
+// thread, 1280 sources × 650 targets: 0.182 against 0.222 ns per pair). Any ranges: a block that
+// runs past a range's end is masked, its missing lanes read as a source at distance ≥ 1 of zero
+// strength (they add exactly zero).
+// (GCC 12's avx512fintrin.h warns on its own _mm512_undefined_ps, GCC bug 105593.)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+__attribute__((target("avx512f")))
+void PointSumRanges512(const SourceColumnsF& c, const SourceRange* ranges, int count,
+                       const float* x, double* w) {
+  const __m512 px = _mm512_set1_ps(x[0]), py = _mm512_set1_ps(x[1]), pz = _mm512_set1_ps(x[2]);
+  const __m512 one = _mm512_set1_ps(1.0f);
+  __m512 wx = _mm512_setzero_ps(), wy = wx, wz = wx;
+  for (int r = 0; r < count; ++r) {
+    for (int s = ranges[r].begin; s < ranges[r].end; s += 16) {
+      const int left = ranges[r].end - s;
+      const __mmask16 m = left >= 16 ? __mmask16(0xFFFF) : static_cast<__mmask16>((1u << left) - 1u);
+      const __m512 rx = _mm512_sub_ps(px, _mm512_maskz_loadu_ps(m, c.x + s));
+      const __m512 ry = _mm512_sub_ps(py, _mm512_maskz_loadu_ps(m, c.y + s));
+      const __m512 rz = _mm512_sub_ps(pz, _mm512_maskz_loadu_ps(m, c.z + s));
+      const __m512 e2 = _mm512_mask_loadu_ps(one, m, c.e2 + s);
+      const __m512 r2 =
+          _mm512_fmadd_ps(rx, rx, _mm512_fmadd_ps(ry, ry, _mm512_fmadd_ps(rz, rz, e2)));
+      const __m512 inv_r = _mm512_div_ps(one, _mm512_sqrt_ps(r2));
+      const __m512 inv_r3 = _mm512_mul_ps(_mm512_mul_ps(inv_r, inv_r), inv_r);
+      const __m512 gx = _mm512_maskz_loadu_ps(m, c.gx + s);
+      const __m512 gy = _mm512_maskz_loadu_ps(m, c.gy + s);
+      const __m512 gz = _mm512_maskz_loadu_ps(m, c.gz + s);
+      const __m512 a = _mm512_fmadd_ps(e2, inv_r3, inv_r);
+      const __m512 b = _mm512_mul_ps(
+          _mm512_fmadd_ps(rx, gx, _mm512_fmadd_ps(ry, gy, _mm512_mul_ps(rz, gz))), inv_r3);
+      wx = _mm512_fmadd_ps(a, gx, _mm512_fmadd_ps(b, rx, wx));
+      wy = _mm512_fmadd_ps(a, gy, _mm512_fmadd_ps(b, ry, wy));
+      wz = _mm512_fmadd_ps(a, gz, _mm512_fmadd_ps(b, rz, wz));
+    }
+  }
+  w[0] += _mm512_reduce_add_ps(wx);
+  w[1] += _mm512_reduce_add_ps(wy);
+  w[2] += _mm512_reduce_add_ps(wz);
+}
+#pragma GCC diagnostic pop
+
+bool HasAvx512() {
+  static const bool has = __builtin_cpu_supports("avx512f");
+  return has;
+}
+#else
+constexpr bool HasAvx512() { return false; }
+void PointSumRanges512(const SourceColumnsF&, const SourceRange*, int, const float*, double*) {}
+#endif
+
+}  // namespace
+
+void AddPointSumSingle(const SourceColumnsF& c, Eigen::Index begin, Eigen::Index end,
+                       const float* x, double* w) {
+  if (!HasAvx512()) return PointSumSinglePortable(c, begin, end, x, w);
+  const SourceRange range{static_cast<int>(begin), static_cast<int>(end)};
+  PointSumRanges512(c, &range, 1, x, w);
+}
+
+void AddPointSumBlocks(const SourceColumnsF& c, const SourceRange* ranges, int count,
+                       const float* x, double* w) {
+  if (HasAvx512()) return PointSumRanges512(c, ranges, count, x, w);
+  PointSumBlocksPortable(c, ranges, count, x, w);
 }
 
 MatX SourceMatrix(const Matrix3X& sources, const VecX& regularization) {
