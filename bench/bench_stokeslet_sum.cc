@@ -15,6 +15,7 @@
 #include <random>
 
 #include "common/helix_lattice.h"
+#include "stokesrods/fluid/mobility_operator.h"
 #include "stokesrods/fluid/stokeslet_sum.h"
 
 namespace stokesrods {
@@ -89,6 +90,74 @@ void Cases(benchmark::internal::Benchmark* b) {
 }
 BENCHMARK(BM_StokesletSumBuild)->Apply(Cases)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_StokesletSumApply)->Apply(Cases)->Unit(benchmark::kMillisecond);
+
+// The matrix-free RSS mobility on helices (65 nodes, r0 = 1 mm) on a lattice 4R apart (helices
+// = 10, 20, 50, 100) or on a ring 3R apart (helices = -10, the bench's ring10), with the near zone
+// at most `max_delta` segment lengths (12: 2 Gauss points at the default accuracy 1e-4, δ = 5.77;
+// 2: 3 points, δ = 1.72; 0: the split chosen by the cost model). Counters: near blocks (3×3, per node pair), the far sum's cost estimate
+// (pairs), Gauss points: the data behind the split's cost model (mobility_operator.cc).
+struct Helices {
+  std::vector<Matrix3X> x;
+  std::vector<HydroRod> rods;
+};
+Helices MakeHelices(int helices) {
+  const int count = std::abs(helices);
+  Helices h;
+  h.x.reserve(static_cast<size_t>(count));
+  for (int k = 0; k < count; ++k) {
+    const double helix_radius = 0.01;
+    const Vec3 base = helices < 0 ? Vec3(3.0 * helix_radius / (2.0 * std::sin(kPi / count)) *
+                                             Vec3(std::cos(2.0 * kPi * k / count),
+                                                  std::sin(2.0 * kPi * k / count), 0.0))
+                                  : Vec3(0.04 * (k / 10), 0.04 * (k % 10), 0.0);
+    Matrix3X x(3, 65);
+    for (int i = 0; i < 65; ++i) {
+      const double z = 0.2 * i / 64.0, phi = 2.0 * kPi * z / 0.05;
+      x.col(i) = base + Vec3(helix_radius * std::cos(phi), helix_radius * std::sin(phi), -z);
+    }
+    h.x.push_back(x);
+  }
+  for (const Matrix3X& x : h.x) h.rods.push_back({&x, 1e-3});
+  return h;
+}
+
+std::unique_ptr<MobilityOperator> MakeMatrixFree(double max_delta) {
+  MobilityOptions options;
+  options.kind = MobilityKind::kMatrixFree;
+  options.split_by_cost = max_delta == 0.0;  // 0: the split the cost model chooses
+  options.fast_sum_near_delta = options.split_by_cost ? 12.0 : max_delta;
+  return MakeMobilityOperator(FluidParams{}, options);
+}
+
+// Arguments: helices (negative: a ring), max_delta.
+void BM_MatrixFreeUpdate(benchmark::State& st) {
+  const Helices h = MakeHelices(static_cast<int>(st.range(0)));
+  auto m = MakeMatrixFree(static_cast<double>(st.range(1)));
+  for (auto _ : st) m->Update(h.rods);
+}
+
+void BM_MatrixFreeApply(benchmark::State& st) {
+  const Helices h = MakeHelices(static_cast<int>(st.range(0)));
+  auto m = MakeMatrixFree(static_cast<double>(st.range(1)));
+  m->Update(h.rods);
+  const VecX f = RandomStrengths(m->size() / 3).reshaped();
+  VecX u;
+  for (auto _ : st) {
+    m->Apply(f, &u);
+    benchmark::DoNotOptimize(u.data());
+  }
+  const MobilityCostCounts counts = m->cost_counts();
+  st.counters["near_blocks"] = static_cast<double>(counts.near_blocks);
+  st.counters["far_pairs"] = counts.far_sum_cost;
+  st.counters["points"] = counts.gauss_points;
+}
+
+void MatrixFreeCases(benchmark::internal::Benchmark* b) {
+  for (int helices : {-10, 10, 20, 50, 100})
+    for (int max_delta : {12, 2, 0}) b->Args({helices, max_delta});
+}
+BENCHMARK(BM_MatrixFreeUpdate)->Apply(MatrixFreeCases)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MatrixFreeApply)->Apply(MatrixFreeCases)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace stokesrods

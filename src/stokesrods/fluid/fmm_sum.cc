@@ -203,6 +203,7 @@ void FmmStokesletSum::Build(const Matrix3X& sources, const VecX& regularization,
   stats_.near_pairs = tree_.near_pairs;
   stats_.far_pairs = static_cast<std::int64_t>(pairs) - tree_.near_pairs;
   stats_.max_rank = 3 * op_->points;
+  stats_.cost = tree_.cost;
   stats_.stored_values = src_.size() + x_.size();
   for (int l = 2; l < levels; ++l) {
     const auto boxes = static_cast<Eigen::Index>(tree_.levels[static_cast<size_t>(l)].size());

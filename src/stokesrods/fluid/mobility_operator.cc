@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include <Eigen/Geometry>
 
@@ -106,12 +107,15 @@ class MatrixFreeRssMobility final : public MobilityOperator {
       : params_(params),
         accuracy_(std::max(options.tolerance, options.fast_sum_tolerance)),
         split_(ChooseNearFarSplit(accuracy_, options.fast_sum_near_delta)),
+        fewest_points_(split_),
+        split_by_cost_(options.split_by_cost),
         far_(MakeFastStokesletSum(
             {.tolerance = options.fast_sum_tolerance,
              .direct_below_pairs = static_cast<std::int64_t>(options.direct_sum_below),
              .choose_by_cost = options.fast_sum_by_cost})) {}
 
   void Update(const std::vector<HydroRod>& rods) override;
+  void ForgetHistory() override { choose_split_ = true; }
   void Apply(const VecX& force, VecX* velocity) const override;
   MatX SelfBlock(int rod) const override {
     MatX block;
@@ -119,6 +123,9 @@ class MatrixFreeRssMobility final : public MobilityOperator {
     return block;
   }
   void FindNearBlocks(const Matrix3X& targets, NearBlocks* blocks) const override;
+  MobilityCostCounts cost_counts() const override {
+    return {static_cast<std::int64_t>(near_.block.size()), far_->Stats().cost, split_.gauss_points};
+  }
 
  private:
   struct Segment {
@@ -127,9 +134,17 @@ class MatrixFreeRssMobility final : public MobilityOperator {
     int rod = 0;
   };
 
+  // The far rule's points, the far sum and the near blocks at the nodes, for split_.
+  void BuildSplit();
+  // Keeps the cheaper of split_ and the rule with one more point (ChooseNearFarSplit).
+  void ChooseSplitByCost();
+
   FluidParams params_;
   double accuracy_;                 // of the far field, its quadrature and the near pairs
   NearFarSplit split_;
+  NearFarSplit fewest_points_;      // ChooseNearFarSplit's: within the options' largest radius
+  bool split_by_cost_;
+  bool choose_split_ = true;        // at the next Update (the first, then after ForgetHistory)
   std::unique_ptr<StokesletSum> far_;
   std::vector<HydroRod> rods_;
   Matrix3X nodes_;                  // 3 × M
@@ -158,6 +173,40 @@ void MatrixFreeRssMobility::Update(const std::vector<HydroRod>& rods) {
     const double eps = params_.regularization * rods[static_cast<size_t>(r)].radius;
     for (int j = 0; j + 1 < x.cols(); ++j) segments_.push_back({first + j, eps, r});
   }
+  if (choose_split_ && split_by_cost_) return ChooseSplitByCost();
+  BuildSplit();
+}
+
+// The cost of one time step in far-field kernel evaluations (one float pair of the far sum,
+// ≈ 0.2 ns), at about kProductsPerUpdate products per Update (a step's GMRES: 5.4–6.5 on the
+// bench's flagella cases), from the benchmark BM_MatrixFree{Update,Apply}
+// (bench/bench_stokeslet_sum.cc: lattice and ring of 10 helices at 2 and 3 points, one thread):
+// a near block costs ≈ 36 ns ≈ 175 evaluations to build (the closed forms minus the rule, once
+// per Update) and ≈ 1.8 ns ≈ 9 evaluations per product. Deterministic (no timing), and decided
+// on the geometry at the first Update and at every restart point (ForgetHistory), so a run
+// resumed from a checkpoint makes the same choice.
+void MatrixFreeRssMobility::ChooseSplitByCost() {
+  constexpr double kBuildPerBlock = 175.0, kApplyPerBlock = 9.0, kProductsPerUpdate = 6.0;
+  choose_split_ = false;
+  NearFarSplit best = fewest_points_;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (const int extra : {1, 0}) {  // the fewest points last: most often kept, then not rebuilt
+    split_ = {fewest_points_.gauss_points + extra,
+              NearRadius(fewest_points_.gauss_points + extra, accuracy_)};
+    BuildSplit();
+    const MobilityCostCounts c = cost_counts();
+    const auto blocks = static_cast<double>(c.near_blocks);
+    const double cost = kBuildPerBlock * blocks +
+                        kProductsPerUpdate * (c.far_sum_cost + kApplyPerBlock * blocks);
+    if (cost < best_cost) best_cost = cost, best = split_;
+  }
+  if (best.gauss_points != split_.gauss_points) {
+    split_ = best;
+    BuildSplit();
+  }
+}
+
+void MatrixFreeRssMobility::BuildSplit() {
   const double* alpha = nullptr;
   const double* weight = nullptr;
   GaussLegendreRule01(split_.gauss_points, &alpha, &weight);
@@ -340,14 +389,18 @@ NearFarSplit ChooseNearFarSplit(double tolerance, double max_near_delta) {
   // kernel evaluations), while a larger near zone costs exact integrals once per step and 3×3
   // blocks per near pair (tolerances 1e-9 … 1e-5 give 3 points; 1e-8: δ_3 = 10.8).
   NearFarSplit split;
-  const double tol = std::max(tolerance, 1e-15);
   for (int n = 2; n <= 12; ++n) {
-    split.gauss_points = n;  // GaussRuleError(n, δ_n) = tol
-    split.near_delta =
-        std::max(1.0, std::pow(GaussRuleError(n, 1.0) / tol, 1.0 / (2.0 * n - 1.0)));
+    split = {n, NearRadius(n, tolerance)};
     if (split.near_delta <= max_near_delta) break;
   }
   return split;
+}
+
+double NearRadius(int gauss_points, double tolerance) {
+  // GaussRuleError(n, δ_n) = tolerance, at least one segment length.
+  const double tol = std::max(tolerance, 1e-15);
+  return std::max(1.0, std::pow(GaussRuleError(gauss_points, 1.0) / tol,
+                                1.0 / (2.0 * gauss_points - 1.0)));
 }
 
 SelfMobilityPreconditioner::SelfMobilityPreconditioner(const MobilityOperator& mobility) {

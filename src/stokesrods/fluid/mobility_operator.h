@@ -18,6 +18,7 @@
 // matrix-free operator wrapped by fluid/mobility_sources.h).
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -48,6 +49,14 @@ struct NearBlocks {
   }
 };
 
+/// What one product of a matrix-free operator costs (of its last Update): the near corrections'
+/// 3×3 blocks and the far-field sum's estimated cost in kernel evaluations (StokesletSumStats).
+struct MobilityCostCounts {
+  std::int64_t near_blocks = 0;
+  double far_sum_cost = 0.0;
+  int gauss_points = 0;
+};
+
 struct MobilityOptions {
   MobilityKind kind = MobilityKind::kDense;
   /// Matrix-free: bound on the relative error of each far segment–node interaction (quadrature).
@@ -66,6 +75,10 @@ struct MobilityOptions {
   /// Matrix-free: the largest near radius (segment lengths) for the split, which takes
   /// max(tolerance, fast_sum_tolerance) as the quadrature's tolerance [–].
   double fast_sum_near_delta = 12.0;
+  /// Matrix-free: at the first Update and every restart point (ForgetHistory), the split with one
+  /// more Gauss point (and its smaller near zone) replaces that one where the estimated cost of a
+  /// step is lower (mobility_operator.cc); false keeps ChooseNearFarSplit's (tests) [–].
+  bool split_by_cost = true;
   /// Dense: 𝕄 reused across Updates (time steps) by extrapolation while its measured relative
   /// error stays below this (fluid/mobility_reuse.h); 0 assembles at every Update [–].
   double reuse_tolerance = 0.0;
@@ -95,6 +108,8 @@ class MobilityOperator {
   virtual void ForgetHistory() {}
   /// Reuse of 𝕄 across Updates, counted since the operator was made.
   virtual MobilityReuseStats reuse_stats() const { return {}; }
+  /// Matrix-free: the work of one product at the last Update (zeros for the dense operator).
+  virtual MobilityCostCounts cost_counts() const { return {}; }
   /// Matrix-free RSS: the near corrections of the rods (of the last Update) at any targets, as
   /// the operator applies them at its own nodes (cell bodies' points: fluid/mobility_sources.h).
   virtual void FindNearBlocks(const Matrix3X& /*targets*/, NearBlocks* /*blocks*/) const {
@@ -139,5 +154,7 @@ struct NearFarSplit {
 };
 /// The fewest points whose near radius is at most `max_near_delta` segment lengths.
 NearFarSplit ChooseNearFarSplit(double tolerance, double max_near_delta = 12.0);
+/// The near radius δ_n (segment lengths) of the n-point rule at a tolerance.
+double NearRadius(int gauss_points, double tolerance);
 
 }  // namespace stokesrods

@@ -17,7 +17,6 @@ class MobilityWithBodySources final : public MobilityOperator {
                           std::unique_ptr<MobilityOperator> rods_operator)
       : params_(params),
         accuracy_(std::max(options.tolerance, options.fast_sum_tolerance)),
-        split_(ChooseNearFarSplit(accuracy_, options.fast_sum_near_delta)),
         rods_operator_(std::move(rods_operator)) {
     SR_ASSERT(!params.wall, "bodies as sources: no wall images here (dense operator)");
   }
@@ -29,13 +28,13 @@ class MobilityWithBodySources final : public MobilityOperator {
   MatX SelfBlock(int rod) const override { return rods_operator_->SelfBlock(rod); }
   void ForgetHistory() override { rods_operator_->ForgetHistory(); }
   MobilityReuseStats reuse_stats() const override { return rods_operator_->reuse_stats(); }
+  MobilityCostCounts cost_counts() const override { return rods_operator_->cost_counts(); }
 
  private:
   void AddRodsAtPoints(const VecX& force, VecX* velocity) const;
 
   FluidParams params_;
   double accuracy_;
-  NearFarSplit split_;
   std::unique_ptr<MobilityOperator> rods_operator_;
   std::vector<HydroRod> rods_;
   std::vector<BodySurface> bodies_;
@@ -86,7 +85,7 @@ void MobilityWithBodySources::UpdateWithBodies(const std::vector<HydroRod>& rods
 // velocity (at the body points) += the rods' segments: the far rule at every segment, summed
 // directly, plus the near blocks.
 void MobilityWithBodySources::AddRodsAtPoints(const VecX& force, VecX* velocity) const {
-  const int g = split_.gauss_points;
+  const int g = rods_operator_->cost_counts().gauss_points;  // the rods' rule, as in their near blocks
   const double* alpha = nullptr;
   const double* weight = nullptr;
   GaussLegendreRule01(g, &alpha, &weight);

@@ -222,6 +222,7 @@ class DirectStokesletSum final : public StokesletSum {
     StokesletSumStats stats;
     stats.near_pairs = static_cast<std::int64_t>(src_.rows()) * targets_.cols();
     stats.stored_values = src_.size() + targets_.size();
+    stats.cost = static_cast<double>(stats.near_pairs);
     return stats;
   }
 

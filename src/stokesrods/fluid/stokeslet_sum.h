@@ -40,6 +40,8 @@ struct StokesletSumStats {
   std::int64_t far_pairs = 0;   ///< (target, source) pairs summed by expansions
   std::int64_t stored_values = 0;  ///< doubles stored by Build (points, expansions)
   int max_rank = 0;                ///< rank of the compressed M2L translations
+  /// Estimated cost of one Apply in kernel evaluations (the direct sum: sources × targets).
+  double cost = 0.0;
 };
 
 class StokesletSum {
