@@ -45,6 +45,13 @@ TEST(BodiesConfig, WallIsReadNormalizedAndEchoed) {
                                           "case.toml"));
   EXPECT_EQ(mf.hydro.mobility.kind, MobilityKind::kMatrixFree);
   ASSERT_TRUE(mf.fluid.wall.has_value());
+  // "auto" with a wall chooses as without one: matrix-free above 500 nodes.
+  const std::string big = "[[rods]]\nnodes = 501\naxis_length = 0.5\nhelix_radius = 0.008\n";
+  for (const bool wall : {false, true}) {
+    const Model m_auto = BuildModel(ParseConfig(
+        std::string(kRun) + big + (wall ? "[wall]\npoint = [0.0, 0.0, -0.6]\n" : ""), "case.toml"));
+    EXPECT_EQ(m_auto.hydro.mobility.kind, MobilityKind::kMatrixFree) << "wall " << wall;
+  }
 }
 
 TEST(BodiesConfig, BodiesAreReadAndEchoedWithOverrides) {

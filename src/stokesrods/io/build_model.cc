@@ -246,12 +246,12 @@ Model BuildModel(const Config& config) {
   // "auto": the dense 𝕄 (3M × 3M) while it is small, the matrix-free operator above 500 nodes.
   // Measured (docs/performance.md, one thread, h = 1 ms): 2 helices (130 nodes) 2.1 ms dense
   // against 3.6 ms matrix-free, 4 helices (260) 7.2 against 10.7 ms, 10 helices (650) 58.9
-  // against 52.6 ms with 3× less memory.
+  // against 52.6 ms with 3× less memory; above a wall (h = 10 ms) 10 helices 188 against 170 ms
+  // with 5× less memory. With bodies "auto" stays dense (slower matrix-free: docs/performance.md).
   const bool matrix_free =
       config.fluid.mobility == "matrix_free" ||
       (config.fluid.mobility == "auto" && model.fluid.model == FluidModel::kRss &&
-       model.num_nodes > 500 && config.fluid.solver != "direct" && !config.wall &&
-       config.bodies.empty());  // bodies and walls: dense only (config_bodies.cc)
+       model.num_nodes > 500 && config.fluid.solver != "direct" && config.bodies.empty());
   model.hydro.mobility.kind = matrix_free ? MobilityKind::kMatrixFree : MobilityKind::kDense;
   // The dense 𝕄 of the Krylov path is assembled to the far-field tolerance (fewer Gauss points
   // far away); the direct solver, the reference, keeps round-off.

@@ -32,7 +32,7 @@ const std::map<std::string, std::string>& Meanings() {
       {"fluid.viscosity", "μ [Pa·s]"},
       {"fluid.regularization", "RSS blob size ε in units of the rod radius r0"},
       {"fluid.coupling", "\"implicit\": the drag solved with the step (stable at any h); \"explicit\": the paper's Algorithm 1 (drag from the last step; stable only below h ≈ 2m/c, refused above)"},
-      {"fluid.mobility", "\"auto\" (dense up to 500 nodes, and with bodies or a wall), \"dense\" or \"matrix_free\" (RSS only; takes bodies and a wall)"},
+      {"fluid.mobility", "\"auto\" (dense up to 500 nodes, and with bodies), \"dense\" or \"matrix_free\" (RSS only; takes bodies and a wall)"},
       {"fluid.far_field_tolerance", "dense Krylov path: relative error of one far segment–node interaction; matrix-free: the far field is accurate to the larger of this and fast_sum_tolerance"},
       {"fluid.fast_sum_tolerance", "matrix-free: error bound of the far-field sum at every size (sets the FMM's expansion order, single precision from 1e-4, with bodies at most 1e-5 in double; the FMM runs only where it pays, from about 20 flagella)"},
       {"fluid.mobility_reuse_tolerance", "dense RSS mobility: 𝕄 is extrapolated from its last two assemblies between steps while its measured relative error (Frobenius) stays below this; 0 assembles it at every step; summary.json mobility_reuse"},
