@@ -297,6 +297,34 @@ TEST(StokesletSumTest, BlockKernelOverRangesMatchesThePlainSum) {
   }
 }
 
+// The double kernel over ranges that are not whole blocks (AVX-512: a masked last block of 8;
+// portable: a remainder loop), both against the kernel summed pair by pair, to round-off.
+TEST(StokesletSumTest, DoubleKernelOverAnyRangeMatchesTheKernel) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> unit(-0.1, 0.1), size(0.5e-3, 2e-3);
+  MatX src(29, 7);
+  for (Eigen::Index s = 0; s < src.rows(); ++s) {
+    const double eps = size(rng);
+    src.row(s) << unit(rng), unit(rng), unit(rng), eps * eps, unit(rng), unit(rng), unit(rng);
+  }
+  for (const auto& [begin, end] : {std::pair{0, 29}, std::pair{3, 14}, std::pair{8, 16},
+                                   std::pair{5, 6}, std::pair{7, 7}}) {
+    const Vec3 x(unit(rng), unit(rng), unit(rng));
+    Vec3 ref = Vec3::Zero();
+    for (int s = begin; s < end; ++s)
+      ref += RegularizedStokesletMatrix(x - src.row(s).head<3>().transpose(), std::sqrt(src(s, 3))) *
+             src.row(s).tail<3>().transpose();
+    double w[3] = {0.0, 0.0, 0.0}, portable[3] = {0.0, 0.0, 0.0};
+    AddPointSum(Columns(src), begin, end, x.data(), w);
+    PointSumPortable(Columns(src), begin, end, x.data(), portable);
+    const double scale = SumScale(src, begin, end, x);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(w[c], ref[c], 1e-14 * scale) << begin << " " << end;
+      EXPECT_NEAR(portable[c], ref[c], 1e-14 * scale) << begin << " " << end;
+    }
+  }
+}
+
 // The single-precision kernel over ranges that are not whole blocks (the AVX-512 path masks the
 // last block; the portable loop has a remainder), against the plain loop in double.
 TEST(StokesletSumTest, SingleKernelOverAnyRangeMatchesThePlainSum) {

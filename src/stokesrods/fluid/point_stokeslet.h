@@ -49,8 +49,10 @@ struct SourceRange {
 void AddPointSumBlocks(const SourceColumnsF& c, const SourceRange* ranges, int count,
                        const float* x, double* w);
 
-/// The compiler-vectorized loops behind AddPointSumSingle and AddPointSumBlocks on CPUs without
-/// AVX-512 (there the sums run on intrinsics; the tests check both against the double sum).
+/// The compiler-vectorized loops behind AddPointSum, AddPointSumSingle and AddPointSumBlocks on
+/// CPUs without AVX-512 (there the sums run on intrinsics; the tests check both paths).
+void PointSumPortable(const SourceColumns& c, Eigen::Index begin, Eigen::Index end,
+                      const double* x, double* w);
 void PointSumSinglePortable(const SourceColumnsF& c, Eigen::Index begin, Eigen::Index end,
                             const float* x, double* w);
 void PointSumBlocksPortable(const SourceColumnsF& c, const SourceRange* ranges, int count,

@@ -1,9 +1,9 @@
 // The direct sum of regularized Stokeslets and its vectorized inner loop (point_stokeslet.h). The
 // fast sum is the kernel-independent FMM of fmm_sum.cc.
 //
-// MEASURED (AMD EPYC, ms, one thread): the direct sum, vectorized (AVX-512/AVX2 clones chosen at
-// run time, -fno-math-errno), costs 1.7 ns per pair: Apply 1.4 (10 helices of the lattice in
-// tests/common/helix_lattice.h), 5.6 (20), 34 (50), 141 (100); Build ≈ 0.
+// MEASURED (AMD EPYC, one thread, 1280 sources × 650 targets): the direct sum on AVX-512
+// intrinsics costs 0.46 ns per pair in double and 0.18 ns in single precision (the compiler's
+// vectorization of the portable loops, kept for CPUs without AVX-512: 1.6 and 0.22 ns).
 #include "stokesrods/fluid/stokeslet_sum.h"
 
 #include <cmath>
@@ -22,9 +22,9 @@ SourceColumns Columns(const MatX& src) {
           src.col(4).data(), src.col(5).data(), src.col(6).data()};
 }
 
-__attribute__((target_clones("avx512f", "avx2", "default")))
-void AddPointSum(const SourceColumns& c, Eigen::Index begin, Eigen::Index end, const double* x,
-                 double* w) {
+__attribute__((target_clones("avx2", "default")))
+void PointSumPortable(const SourceColumns& c, Eigen::Index begin, Eigen::Index end,
+                      const double* x, double* w) {
   double wx = 0.0, wy = 0.0, wz = 0.0;
 #pragma omp simd reduction(+ : wx, wy, wz)
   for (Eigen::Index s = begin; s < end; ++s) {
@@ -147,6 +147,40 @@ void PointSumRanges512(const SourceColumnsF& c, const SourceRange* ranges, int c
   w[1] += _mm512_reduce_add_ps(wy);
   w[2] += _mm512_reduce_add_ps(wz);
 }
+
+// The double sum likewise (8 lanes): 0.456 against 1.61 ns per pair for GCC 12's code of the
+// portable loop (same measurement as above).
+__attribute__((target("avx512f")))
+void PointSumRange512(const SourceColumns& c, Eigen::Index begin, Eigen::Index end,
+                      const double* x, double* w) {
+  const __m512d px = _mm512_set1_pd(x[0]), py = _mm512_set1_pd(x[1]), pz = _mm512_set1_pd(x[2]);
+  const __m512d one = _mm512_set1_pd(1.0);
+  __m512d wx = _mm512_setzero_pd(), wy = wx, wz = wx;
+  for (Eigen::Index s = begin; s < end; s += 8) {
+    const Eigen::Index left = end - s;
+    const __mmask8 m = left >= 8 ? __mmask8(0xFF) : static_cast<__mmask8>((1u << left) - 1u);
+    const __m512d rx = _mm512_sub_pd(px, _mm512_maskz_loadu_pd(m, c.x + s));
+    const __m512d ry = _mm512_sub_pd(py, _mm512_maskz_loadu_pd(m, c.y + s));
+    const __m512d rz = _mm512_sub_pd(pz, _mm512_maskz_loadu_pd(m, c.z + s));
+    const __m512d e2 = _mm512_mask_loadu_pd(one, m, c.e2 + s);
+    const __m512d r2 =
+        _mm512_fmadd_pd(rx, rx, _mm512_fmadd_pd(ry, ry, _mm512_fmadd_pd(rz, rz, e2)));
+    const __m512d inv_r = _mm512_div_pd(one, _mm512_sqrt_pd(r2));
+    const __m512d inv_r3 = _mm512_mul_pd(_mm512_mul_pd(inv_r, inv_r), inv_r);
+    const __m512d gx = _mm512_maskz_loadu_pd(m, c.gx + s);
+    const __m512d gy = _mm512_maskz_loadu_pd(m, c.gy + s);
+    const __m512d gz = _mm512_maskz_loadu_pd(m, c.gz + s);
+    const __m512d a = _mm512_fmadd_pd(e2, inv_r3, inv_r);
+    const __m512d b = _mm512_mul_pd(
+        _mm512_fmadd_pd(rx, gx, _mm512_fmadd_pd(ry, gy, _mm512_mul_pd(rz, gz))), inv_r3);
+    wx = _mm512_fmadd_pd(a, gx, _mm512_fmadd_pd(b, rx, wx));
+    wy = _mm512_fmadd_pd(a, gy, _mm512_fmadd_pd(b, ry, wy));
+    wz = _mm512_fmadd_pd(a, gz, _mm512_fmadd_pd(b, rz, wz));
+  }
+  w[0] += _mm512_reduce_add_pd(wx);
+  w[1] += _mm512_reduce_add_pd(wy);
+  w[2] += _mm512_reduce_add_pd(wz);
+}
 #pragma GCC diagnostic pop
 
 bool HasAvx512() {
@@ -156,9 +190,16 @@ bool HasAvx512() {
 #else
 constexpr bool HasAvx512() { return false; }
 void PointSumRanges512(const SourceColumnsF&, const SourceRange*, int, const float*, double*) {}
+void PointSumRange512(const SourceColumns&, Eigen::Index, Eigen::Index, const double*, double*) {}
 #endif
 
 }  // namespace
+
+void AddPointSum(const SourceColumns& c, Eigen::Index begin, Eigen::Index end, const double* x,
+                 double* w) {
+  if (HasAvx512()) return PointSumRange512(c, begin, end, x, w);
+  PointSumPortable(c, begin, end, x, w);
+}
 
 void AddPointSumSingle(const SourceColumnsF& c, Eigen::Index begin, Eigen::Index end,
                        const float* x, double* w) {
