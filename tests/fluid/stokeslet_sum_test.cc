@@ -297,16 +297,23 @@ TEST(StokesletSumTest, BlockKernelOverRangesMatchesThePlainSum) {
   }
 }
 
+// n sources as rows (x, y, z, ε², g) in a 0.2 m cube, ε in [0.5, 2] mm, g in [−0.1, 0.1]³.
+MatX RandomSourceRows(int n, std::mt19937* rng) {
+  std::uniform_real_distribution<double> unit(-0.1, 0.1), size(0.5e-3, 2e-3);
+  MatX src(n, 7);
+  for (Eigen::Index s = 0; s < n; ++s) {
+    const double eps = size(*rng);
+    src.row(s) << unit(*rng), unit(*rng), unit(*rng), eps * eps, unit(*rng), unit(*rng), unit(*rng);
+  }
+  return src;
+}
+
 // The double kernel over ranges that are not whole blocks (AVX-512: a masked last block of 8;
 // portable: a remainder loop), both against the kernel summed pair by pair, to round-off.
 TEST(StokesletSumTest, DoubleKernelOverAnyRangeMatchesTheKernel) {
   std::mt19937 rng(7);
-  std::uniform_real_distribution<double> unit(-0.1, 0.1), size(0.5e-3, 2e-3);
-  MatX src(29, 7);
-  for (Eigen::Index s = 0; s < src.rows(); ++s) {
-    const double eps = size(rng);
-    src.row(s) << unit(rng), unit(rng), unit(rng), eps * eps, unit(rng), unit(rng), unit(rng);
-  }
+  std::uniform_real_distribution<double> unit(-0.1, 0.1);
+  const MatX src = RandomSourceRows(29, &rng);
   for (const auto& [begin, end] : {std::pair{0, 29}, std::pair{3, 14}, std::pair{8, 16},
                                    std::pair{5, 6}, std::pair{7, 7}}) {
     const Vec3 x(unit(rng), unit(rng), unit(rng));
@@ -329,12 +336,8 @@ TEST(StokesletSumTest, DoubleKernelOverAnyRangeMatchesTheKernel) {
 // last block; the portable loop has a remainder), against the plain loop in double.
 TEST(StokesletSumTest, SingleKernelOverAnyRangeMatchesThePlainSum) {
   std::mt19937 rng(6);
-  std::uniform_real_distribution<double> unit(-0.1, 0.1), size(0.5e-3, 2e-3);
-  MatX real(53, 7);
-  for (Eigen::Index s = 0; s < real.rows(); ++s) {
-    const double eps = size(rng);
-    real.row(s) << unit(rng), unit(rng), unit(rng), eps * eps, unit(rng), unit(rng), unit(rng);
-  }
+  std::uniform_real_distribution<double> unit(-0.1, 0.1);
+  MatX real = RandomSourceRows(53, &rng);
   const Eigen::MatrixXf single = real.cast<float>();
   real = single.cast<double>();  // the same rounded points
   for (const auto& [begin, end] : {std::pair{0, 53}, std::pair{3, 40}, std::pair{16, 32},
