@@ -112,7 +112,10 @@ class MatrixFreeRssMobility final : public MobilityOperator {
         far_(MakeFastStokesletSum(
             {.tolerance = options.fast_sum_tolerance,
              .direct_below_pairs = static_cast<std::int64_t>(options.direct_sum_below),
-             .choose_by_cost = options.fast_sum_by_cost})) {}
+             .choose_by_cost = options.fast_sum_by_cost})) {
+    SR_ASSERT(!params.wall, "the matrix-free RSS is the free-space operator: a wall's images wrap "
+                            "it (MakeMobilityWithWallImages, fluid/wall_sources.h)");
+  }
 
   void Update(const std::vector<HydroRod>& rods) override;
   void ForgetHistory() override { choose_split_ = true; }

@@ -85,7 +85,7 @@ void ValidateWall(Config* config) {
     throw ConfigError(file, "wall",
                       fmt::format("fluid.model = \"{}\" has no wall: a wall acts through the "
                                   "regularized images of fluid.model = \"rss\" (no wall "
-                                  "correction of LSBT or RFT, no wall contact yet)",
+                                  "correction of LSBT or RFT)",
                                   model));
 }
 
