@@ -5,7 +5,8 @@ Each cell is the two-flagella swimming cell of examples/swimming_cell_two_flagel
 sphere of radius 25 mm, 400 surface points, two 65-node helices turned at omega_bar = 320), the
 cells on a square grid 0.1 m apart, implicit Euler at 20 ms, one thread. The CPU per step is the
 difference of two runs (S1 and S2 steps) over S2 - S1, so that start-up and the first steps from
-rest cancel; the peak memory (max RSS) is that of the longer run.
+rest cancel; the peak memory (max RSS) and the GMRES products per Newton iteration
+(summary.json krylov_products / newton_iterations) are those of the longer run.
 
     swimming_cells_bench.py STOKESRODS [--cells 1 4 9] [--steps 3 8] [--out DIR]
 
@@ -68,10 +69,11 @@ def main():
     parser.add_argument("--out", default=None)
     args = parser.parse_args()
     out = args.out or tempfile.mkdtemp(prefix="swimming_cells_")
+    pathlib.Path(out).mkdir(parents=True, exist_ok=True)
     s1, s2 = args.steps
     print("| cells | flagella | nodes M | body points P | unknowns 3(M+P)+6B | mobility | "
-          "CPU per step [ms] | peak RSS [MB] | Newton per step |")
-    print("|---|---|---|---|---|---|---|---|---|")
+          "CPU per step [ms] | peak RSS [MB] | Newton per step | GMRES products per Newton |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for cells in args.cells:
         for mobility in args.mobility:
             cpu1, _, _ = run(args.binary, cells, s1, mobility, out)
@@ -79,8 +81,9 @@ def main():
             m, p = 130 * cells, 400 * cells
             per_step = 1e3 * (cpu2 - cpu1) / (s2 - s1)
             newton = summary["newton_iterations"] / max(summary["steps"], 1)
+            products = summary.get("krylov_products", 0) / max(summary["newton_iterations"], 1)
             print(f"| {cells} | {2 * cells} | {m} | {p} | {3 * (m + p) + 6 * cells} | {mobility} "
-                  f"| {per_step:.0f} | {rss:.0f} | {newton:.2f} |", flush=True)
+                  f"| {per_step:.0f} | {rss:.0f} | {newton:.2f} | {products:.1f} |", flush=True)
 
 
 if __name__ == "__main__":

@@ -1,7 +1,9 @@
 // The capacitance's block preconditioner with bodies (sim/capacitance_preconditioner.h) against
 // the straightforward path it replaces: the same matrix P — the rods' blocks D_k, each body's
-// h𝕄_bb and the free bodies' border — assembled densely and solved by LU. The border's rows and
-// columns come from the dense bordered mobility (AssembleBorderedMobility, h G_b and h G_bᵀ) and
+// h𝕄_bb, the cell's flow between its body and its rods and among its rods (h𝕄_kb, h𝕄_bk,
+// h𝕄_kl), and the free bodies' border — assembled densely and solved by LU. The cell's blocks and
+// the border's rows and columns come from the dense bordered mobility of the whole system
+// (AssembleBorderedMobility, h 𝕄 and h G_b, h G_bᵀ) and
 // from AddClampBordersToCapacitance (the clamped rods' h SΓ, h G_cᵀ(S_cᵀ − B_c X), h²K), i.e. from
 // the code that assembles the dense C itself, while the preconditioner builds them on its own. The
 // blocks are LU-factorized in single precision: agreement to 1e-4 relative (measured below).
@@ -62,10 +64,30 @@ TEST(CapacitancePreconditioner, SolvesTheBorderedBlocksAsTheirDenseLu) {
     const int first = 3 * model.rods[static_cast<size_t>(r)].node_offset;
     p.block(first, first, rod_blocks[static_cast<size_t>(r)].rows(), rod_blocks[static_cast<size_t>(r)].cols()) = rod_blocks[static_cast<size_t>(r)];
   }
+  // Each body's h𝕄_bb, and a cell's flow between the body and its rods and among its rods.
+  std::vector<std::pair<int, int>> body_range;  // (first, size) of each body's points
   for (int first = m; const BodySurface& b : bodies) {
-    const auto size = 3 * b.points.cols();
-    p.block(first, first, size, size) = h * bordered.block(first, first, size, size);
-    first += static_cast<int>(size);
+    body_range.emplace_back(first, static_cast<int>(3 * b.points.cols()));
+    first += static_cast<int>(3 * b.points.cols());
+  }
+  auto rod_range = [&](int r) {
+    const RodModel& rod = model.rods[static_cast<size_t>(r)];
+    return std::pair<int, int>(3 * rod.node_offset, 3 * rod.num_nodes());
+  };
+  auto copy = [&](std::pair<int, int> rows, std::pair<int, int> cols) {
+    p.block(rows.first, cols.first, rows.second, cols.second) =
+        h * bordered.block(rows.first, cols.first, rows.second, cols.second);
+  };
+  for (std::size_t k = 0; k < bodies.size(); ++k) {
+    copy(body_range[k], body_range[k]);
+    for (int r = 0; r < static_cast<int>(model.rods.size()); ++r) {
+      if (model.rods[static_cast<size_t>(r)].body != static_cast<int>(k)) continue;
+      copy(rod_range(r), body_range[k]);
+      copy(body_range[k], rod_range(r));
+      for (int l = 0; l < static_cast<int>(model.rods.size()); ++l)
+        if (l != r && model.rods[static_cast<size_t>(l)].body == static_cast<int>(k))
+          copy(rod_range(r), rod_range(l));
+    }
   }
   const int v = 3 * model.num_hydro_points();
   p.middleCols(v, 6) += h * bordered.middleCols(v, 6);
@@ -73,7 +95,8 @@ TEST(CapacitancePreconditioner, SolvesTheBorderedBlocksAsTheirDenseLu) {
   AddClampBordersToCapacitance(model, h, borders, &p);
 
   CapacitancePreconditioner preconditioner;
-  ASSERT_TRUE(preconditioner.Build(model, h, rod_blocks, bodies, &borders, nullptr));
+  ASSERT_TRUE(preconditioner.Build(model, h, rod_blocks, MakeHydroRods(model, positions), bodies,
+                                   &borders, false));
   const Eigen::PartialPivLU<MatX> lu(p);
   double worst = 0.0;
   for (int trial = 0; trial < 5; ++trial) {

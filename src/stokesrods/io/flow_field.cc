@@ -44,7 +44,7 @@ std::string WriteFlowField(const Model& model, const State& state, const FlowFie
     std::vector<MatX> self(model.rods.size());
     for (int r = 0; r < static_cast<int>(self.size()); ++r) self[static_cast<size_t>(r)] = mobility->SelfBlock(r);
     CapacitancePreconditioner blocks;
-    if (!blocks.Build(model, 1.0, self, bodies, nullptr, nullptr))
+    if (!blocks.Build(model, 1.0, self, rods, bodies, nullptr, false))
       throw IoError(fmt::format("{}: flow field not written: a block of the mobility is singular",
                                 output_dir));
     const LinearOperator apply = [&](const VecX& x, VecX* y) { mobility->Apply(x, y); };

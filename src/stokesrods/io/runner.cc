@@ -85,6 +85,7 @@ class Observer {
       s["mobility_reuse"] = {{"updates", result.mobility_reuse.updates},
                              {"assemblies", result.mobility_reuse.assemblies},
                              {"largest_error", result.mobility_reuse.largest_error}};
+    s["krylov_products"] = result.krylov_products;
     s["version"] = STOKESRODS_VERSION;
     WriteFileAtomically((fs::path(plan_.output_dir) / "summary.json").string(), s.dump(2) + "\n");
   }
@@ -288,7 +289,10 @@ RunResult RunCase(const Config& config, const RunOptions& options) {
   result.newton_iterations = counters.newton_iterations;
   result.step_reductions = counters.step_reductions;
   result.wall_seconds = wall();
-  if (ws.nonlocal_fluid) result.mobility_reuse = ws.hydro.mobility().reuse_stats();
+  if (ws.nonlocal_fluid) {
+    result.mobility_reuse = ws.hydro.mobility().reuse_stats();
+    result.krylov_products = ws.hydro.krylov_iterations();
+  }
   if (options.progress) options.progress({state.time, plan.duration, result.wall_seconds, state.step});
   observer.WriteSummary(result.status, result.message, result, counters.max_penetration);
   return result;

@@ -51,6 +51,8 @@ struct RunResult {
   /// The dense 𝕄's reuse across steps (fluid.mobility_reuse_tolerance), counted like
   /// wall_seconds over this process's steps only (a resumed run counts from its restart).
   MobilityReuseStats mobility_reuse;
+  /// GMRES products (fluid.solver = "krylov"), counted like wall_seconds.
+  long krylov_products = 0;
 };
 
 /// Runs the configured case and writes its outputs. Throws ConfigError (bad input) and IoError

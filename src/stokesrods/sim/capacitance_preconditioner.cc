@@ -17,47 +17,117 @@ Mat3 Cross(const Vec3& a) {  // [a]× b = a × b
 
 }  // namespace
 
+VecX CapacitancePreconditioner::Block::Gather(const VecX& v) const {
+  VecX x(size);
+  int k = 0;
+  for (const auto& [first, n] : ranges) {
+    x.segment(k, n) = v.segment(first, n);
+    k += n;
+  }
+  return x;
+}
+
+void CapacitancePreconditioner::Block::Scatter(const Eigen::VectorXd& x, VecX* out) const {
+  int k = 0;
+  for (const auto& [first, n] : ranges) {
+    out->segment(first, n) += x.segment(k, n);
+    k += n;
+  }
+}
+
+void CapacitancePreconditioner::MakeBlocks(const Model& model,
+                                           const std::vector<BodySurface>& bodies) {
+  const int num_rods = static_cast<int>(model.rods.size());
+  const int num_bodies = static_cast<int>(bodies.size());
+  blocks_.clear();
+  rod_place_.assign(model.rods.size(), Place{});
+  body_place_.assign(bodies.size(), Place{});
+  auto add = [&](Block* block, Place* place, int first, int n) {
+    *place = {.block = static_cast<int>(blocks_.size()), .offset = block->size};
+    block->ranges.emplace_back(first, n);
+    block->size += n;
+  };
+  for (int r = 0; r < num_rods; ++r) {
+    const RodModel& rod = model.rods[static_cast<size_t>(r)];
+    if (rod.body >= 0) continue;  // in its body's cell
+    Block block;
+    block.rod = r;
+    add(&block, &rod_place_[static_cast<size_t>(r)], 3 * rod.node_offset, 3 * rod.num_nodes());
+    blocks_.push_back(std::move(block));
+  }
+  for (int first = 3 * model.num_nodes, k = 0; k < num_bodies; ++k) {
+    Block block;  // the body's rods, then its points
+    block.body = k;
+    for (int r = 0; r < num_rods; ++r) {
+      const RodModel& rod = model.rods[static_cast<size_t>(r)];
+      if (rod.body == k)
+        add(&block, &rod_place_[static_cast<size_t>(r)], 3 * rod.node_offset, 3 * rod.num_nodes());
+    }
+    const int n = 3 * static_cast<int>(bodies[static_cast<size_t>(k)].points.cols());
+    add(&block, &body_place_[static_cast<size_t>(k)], first, n);
+    first += n;
+    blocks_.push_back(std::move(block));
+  }
+}
+
+MatX CapacitancePreconditioner::BlockMatrix(const Model& model, double h, const Block& block,
+                                            const std::vector<MatX>& rod_blocks,
+                                            const std::vector<HydroRod>& rods,
+                                            const std::vector<BodySurface>& bodies) const {
+  const Wall* wall = model.fluid.wall ? &*model.fluid.wall : nullptr;
+  if (block.rod >= 0) return rod_blocks[static_cast<size_t>(block.rod)];
+  const int body = block.body;
+  const BodySurface& surface = bodies[static_cast<size_t>(body)];
+  if (block.ranges.size() == 1)  // a body with no rods
+    return h * PointStokesletMobility(surface, model.fluid.viscosity, wall);
+  // A cell: h times the dense mobility of its rods and points, the rods' own blocks D_k.
+  std::vector<HydroRod> cell_rods;
+  std::vector<int> cell_rod_index;
+  for (std::size_t r = 0; r < rods.size(); ++r)
+    if (model.rods[r].body == body) {
+      cell_rods.push_back(rods[r]);
+      cell_rod_index.push_back(static_cast<int>(r));
+    }
+  MatX m = h * AssembleMobilityWithBodies(model.fluid, cell_rods, {surface});
+  for (const int r : cell_rod_index) {
+    const Place& place = rod_place_[static_cast<size_t>(r)];
+    const MatX& d = rod_blocks[static_cast<size_t>(r)];
+    m.block(place.offset, place.offset, d.rows(), d.cols()) = d;
+  }
+  return m;
+}
+
 bool CapacitancePreconditioner::Build(const Model& model, double h,
                                       const std::vector<MatX>& rod_blocks,
+                                      const std::vector<HydroRod>& rods,
                                       const std::vector<BodySurface>& bodies,
-                                      const std::vector<ClampBorder>* borders,
-                                      const std::vector<Matrix3X>* positions) {
-  SR_ASSERT(rod_blocks.size() == model.rods.size() && bodies.size() == model.bodies.size(),
+                                      const std::vector<ClampBorder>* borders, bool coarse) {
+  SR_ASSERT(rod_blocks.size() == model.rods.size() && rods.size() == model.rods.size() &&
+                bodies.size() == model.bodies.size(),
             "preconditioner: one block per rod and per body");
-  const int num_rods = static_cast<int>(model.rods.size());
-  const int num_blocks = num_rods + static_cast<int>(bodies.size());
-  block_first_.assign(1, 0);
-  for (const RodModel& rod : model.rods) block_first_.push_back(block_first_.back() + 3 * rod.num_nodes());
-  for (const BodySurface& b : bodies)
-    block_first_.push_back(block_first_.back() + 3 * static_cast<int>(b.points.cols()));
-  size_ = block_first_.back() + 6 * model.num_free_bodies;
-  block_lu_.assign(static_cast<size_t>(num_blocks), DenseLu<float>());
-  const Wall* wall = model.fluid.wall ? &*model.fluid.wall : nullptr;
+  MakeBlocks(model, bodies);
+  size_ = 3 * model.num_hydro_points() + 6 * model.num_free_bodies;
+  const int num_blocks = static_cast<int>(blocks_.size());
   bool ok = true;
 #pragma omp parallel for schedule(dynamic) reduction(&& : ok)
   for (int k = 0; k < num_blocks; ++k) {
-    const auto ku = static_cast<size_t>(k);
-    if (k < num_rods) {
-      ok = block_lu_[ku].Compute(rod_blocks[ku].cast<float>()) && ok;
-    } else {
-      const BodySurface& b = bodies[static_cast<size_t>(k - num_rods)];
-      ok = block_lu_[ku].Compute(
-               (h * PointStokesletMobility(b, model.fluid.viscosity, wall)).cast<float>()) && ok;
-    }
+    Block& block = blocks_[static_cast<size_t>(k)];
+    ok = block.lu.Compute(BlockMatrix(model, h, block, rod_blocks, rods, bodies).cast<float>()) &&
+         ok;
   }
   if (!ok) return false;
   free_bodies_.clear();
   for (int k = 0; k < static_cast<int>(bodies.size()); ++k)
     if (bodies[static_cast<size_t>(k)].free && !BuildFreeBody(model, h, k, bodies, borders))
       return false;
-  coarse_ = positions != nullptr && num_rods > 0;
+  coarse_ = coarse && !rods.empty();
   if (!coarse_) return true;
-  std::vector<CoarseRod> rods(model.rods.size());
+  std::vector<CoarseRod> coarse_rods(model.rods.size());
   for (std::size_t r = 0; r < rods.size(); ++r)
-    rods[r] = {.x = &(*positions)[r],
-               .eps = model.fluid.regularization * model.rods[r].radius,
-               .node_offset = model.rods[r].node_offset};
-  return coarse_level_.Build(rods, rod_blocks, h / (8.0 * kPi * model.fluid.viscosity));
+    coarse_rods[r] = {.x = rods[r].x,
+                      .eps = model.fluid.regularization * model.rods[r].radius,
+                      .node_offset = model.rods[r].node_offset};
+  return coarse_level_.Build(coarse_rods, rod_blocks, h / (8.0 * kPi * model.fluid.viscosity));
 }
 
 bool CapacitancePreconditioner::BuildFreeBody(const Model& model, double h, int body,
@@ -66,50 +136,60 @@ bool CapacitancePreconditioner::BuildFreeBody(const Model& model, double h, int 
   const BodyModel& bm = model.bodies[static_cast<size_t>(body)];
   const BodySurface& surface = bodies[static_cast<size_t>(body)];
   FreeBody fb;
-  fb.body = body;
   fb.unknown = 3 * model.num_hydro_points() + 6 * bm.free_index;
   Mat6 k = Mat6::Zero();
+  // B and Cᵀ per block they touch (the body's own and its rods' blocks: one block for a cell).
+  std::vector<std::pair<MatX, MatX>> parts;
+  auto part = [&](const Place& place) -> std::pair<MatX, MatX>& {
+    const auto it = std::find(fb.blocks.begin(), fb.blocks.end(), place.block);
+    if (it != fb.blocks.end()) return parts[static_cast<size_t>(it - fb.blocks.begin())];
+    const int n = blocks_[static_cast<size_t>(place.block)].size;
+    fb.blocks.push_back(place.block);
+    parts.emplace_back(MatX::Zero(n, 6), MatX::Zero(6, n));
+    return parts.back();
+  };
   // The body's own points: B = h G_b, Cᵀ = h G_bᵀ.
-  const int block = static_cast<int>(model.rods.size()) + body;
-  const auto np = surface.points.cols();
-  MatX columns(3 * np, 6), rows(6, 3 * np);
-  for (Eigen::Index j = 0; j < np; ++j) {
-    const Mat3 arm = Cross(surface.points.col(j) - surface.center);
-    columns.block<3, 3>(3 * j, 0) = h * Mat3::Identity();
-    columns.block<3, 3>(3 * j, 3) = -h * arm;
-    rows.block<3, 3>(0, 3 * j) = h * Mat3::Identity();
-    rows.block<3, 3>(3, 3 * j) = h * arm;
+  {
+    const Place& place = body_place_[static_cast<size_t>(body)];
+    auto& [columns, rows] = part(place);
+    for (Eigen::Index j = 0; j < surface.points.cols(); ++j) {
+      const Mat3 arm = Cross(surface.points.col(j) - surface.center);
+      const auto i = place.offset + 3 * j;
+      columns.block<3, 3>(i, 0) = h * Mat3::Identity();
+      columns.block<3, 3>(i, 3) = -h * arm;
+      rows.block<3, 3>(0, i) = h * Mat3::Identity();
+      rows.block<3, 3>(3, i) = h * arm;
+    }
   }
-  std::vector<std::pair<int, std::pair<MatX, MatX>>> parts;
-  parts.push_back({block, {std::move(columns), std::move(rows)}});
   // Its rods (sim/clamp_border.h): B = h S Γ, Cᵀ = h G_cᵀ (S_cᵀ − B_c X), K = h² K_c.
   if (borders)
     for (const ClampBorder& border : *borders) {
       if (border.unknown != fb.unknown) continue;
       const RodModel& rod = model.rods[static_cast<size_t>(border.rod)];
-      MatX rod_columns(3 * rod.num_nodes(), 6);
+      const Place& place = rod_place_[static_cast<size_t>(border.rod)];
+      auto& [columns, rows] = part(place);
       for (int i = 0; i < rod.num_nodes(); ++i)
-        rod_columns.middleRows<3>(3 * i) = h * border.gamma.middleRows<3>(NodeDof(i));
+        columns.middleRows<3>(place.offset + 3 * i) = h * border.gamma.middleRows<3>(NodeDof(i));
       MatX coupling = -border.row_x;
       for (std::size_t a = 0; a < border.dofs.size(); ++a) {
         const int dof = border.dofs[a];
         if (dof % 4 != 3) coupling(static_cast<Eigen::Index>(a), 3 * (dof / 4) + dof % 4) += 1.0;
       }
-      parts.push_back({border.rod, {std::move(rod_columns), h * border.g.transpose() * coupling}});
+      rows.middleCols(place.offset, 3 * rod.num_nodes()) = h * border.g.transpose() * coupling;
       k += h * h * border.k;
     }
   Mat6 schur = k;
-  for (auto& [b, part] : parts) {
-    MatX solved = part.first;
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    const Block& block = blocks_[static_cast<size_t>(fb.blocks[p])];
+    MatX solved = parts[p].first;
     for (int c = 0; c < 6; ++c) {
       Eigen::VectorXf x = solved.col(c).cast<float>();
-      block_lu_[static_cast<size_t>(b)].Solve(&x);
+      block.lu.Solve(&x);
       solved.col(c) = x.cast<double>();
     }
-    schur -= part.second * solved;
-    fb.first.push_back(block_first_[static_cast<size_t>(b)]);
+    schur -= parts[p].second * solved;
     fb.columns_solved.push_back(std::move(solved));
-    fb.rows.push_back(std::move(part.second));
+    fb.rows.push_back(std::move(parts[p].second));
   }
   fb.schur.compute(schur);
   if (!(std::abs(fb.schur.determinant()) > 0.0)) return false;
@@ -119,14 +199,13 @@ bool CapacitancePreconditioner::BuildFreeBody(const Model& model, double h, int 
 
 void CapacitancePreconditioner::SolveBlocks(const VecX& v, VecX* out) const {
   out->setZero(v.size());
-  const int num_blocks = static_cast<int>(block_lu_.size());
+  const int num_blocks = static_cast<int>(blocks_.size());
 #pragma omp parallel for schedule(dynamic) if (num_blocks > 1)
-  for (int k = 0; k < num_blocks; ++k) {
-    const int first = block_first_[static_cast<size_t>(k)];
-    const int n = block_first_[static_cast<size_t>(k) + 1] - first;
-    Eigen::VectorXf x = v.segment(first, n).cast<float>();
-    block_lu_[static_cast<size_t>(k)].Solve(&x);
-    out->segment(first, n) = x.cast<double>();
+  for (int k = 0; k < num_blocks; ++k) {  // the blocks' entries are disjoint
+    const Block& block = blocks_[static_cast<size_t>(k)];
+    Eigen::VectorXf x = block.Gather(v).cast<float>();
+    block.lu.Solve(&x);
+    block.Scatter(x.cast<double>(), out);
   }
 }
 
@@ -135,11 +214,11 @@ void CapacitancePreconditioner::SolveFine(const VecX& v, VecX* out) const {
   for (const FreeBody& fb : free_bodies_) {
     Vec6 rhs = v.segment<6>(fb.unknown);
     for (std::size_t p = 0; p < fb.rows.size(); ++p)
-      rhs -= fb.rows[p] * out->segment(fb.first[p], fb.rows[p].cols());
+      rhs -= fb.rows[p] * blocks_[static_cast<size_t>(fb.blocks[p])].Gather(*out);
     const Vec6 motion = fb.schur.solve(rhs);
     out->segment<6>(fb.unknown) = motion;
     for (std::size_t p = 0; p < fb.rows.size(); ++p)
-      out->segment(fb.first[p], fb.columns_solved[p].rows()) -= fb.columns_solved[p] * motion;
+      blocks_[static_cast<size_t>(fb.blocks[p])].Scatter(-fb.columns_solved[p] * motion, out);
   }
 }
 

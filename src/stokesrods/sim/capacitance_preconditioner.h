@@ -4,16 +4,20 @@
 //
 // The unknowns are those of the bordered mobility: the rods' M nodal forces, the bodies' P point
 // forces, then V = (U, Ω) of each free body (fluid/rigid_body.h).
-//   Fine level: A, the block diagonal of C over the rods (D_k = h 𝕄_kk + S_k X_k) and over the
-//     bodies (h 𝕄_bb, the regularized Stokeslets of a body's points among themselves), each by
-//     its LU in single precision; bordered exactly by each free body's six unknowns, which couple
+//   Fine level: A, the block diagonal of C over the rods (D_k = h 𝕄_kk + S_k X_k), over the
+//     bodies (h 𝕄_bb, the regularized Stokeslets of a body's points among themselves) and over
+//     the cells: a body and the rods clamped on it as one block (its D_k, h 𝕄_bb and the flow
+//     between them, h 𝕄_kb, h 𝕄_bk, h 𝕄_kl, as the dense bordered mobility has them:
+//     fluid/rigid_body.h AssembleMobilityWithBodies), each by its LU in single precision;
+//     bordered exactly by each free body's six unknowns, which couple
 //     to its own points (h G_b, h G_bᵀ: u_j = U + Ω × (x_j − c)) and to the rods clamped on it
 //     (h S Γ_c, h G_cᵀ (S_cᵀ − B_c X), h² K_c: sim/clamp_border.h). With B the columns of V and
 //     Cᵀ its rows, [A B; Cᵀ K] y = r is solved by the Schur complement on V (6 × 6 per body):
 //         z = A⁻¹ r,   y_V = Σ⁻¹ (r_V − Cᵀ z),   y = z − A⁻¹ B y_V,   Σ = K − Cᵀ A⁻¹ B
 //     (A⁻¹ B once per build: the body's and its rods' blocks solved for six columns each). So a
-//     swimming cell's body, flagella and motion are one exact block but for the flow they make
-//     at each other.
+//     swimming cell's body, flagella, the flow between them and its motion are one exact block
+//     (without the flow between a body and its own flagella GMRES needed 3.5× more products:
+//     docs/performance.md).
 //   Coarse level (optional, sim/coarse_level.h): per rod, 4 chunks of consecutive nodes with a
 //     uniform force each (columns Z), E = Zᵀ W with W ≈ C Z on the rods' rows (zero on the
 //     bodies' and their motions' rows). One application: c = E⁻¹ Zᵀ r,
@@ -36,34 +40,53 @@ namespace stokesrods {
 
 class CapacitancePreconditioner {
  public:
-  /// `rod_blocks`: D_k of each rod (3N_k square); `bodies`: the surfaces at the step's start (the
+  /// `rod_blocks`: D_k of each rod (3N_k square); `rods`: the rods as the fluid sees them (for
+  /// the cell blocks and the coarse level); `bodies`: the surfaces at the step's start (the
   /// model's order); `borders`: the rods on free bodies (Γ, K and row_x completed) or nullptr;
-  /// `positions`: the rods' nodes for the coarse level, or nullptr for the fine level alone.
-  /// C = h𝕄 + …: h scales the bodies' blocks and borders (1 for 𝕄 itself). False if a block or
-  /// a Schur complement is singular.
+  /// `coarse`: with the coarse level. C = h𝕄 + …: h scales the bodies' blocks and borders (1 for
+  /// 𝕄 itself). False if a block or a Schur complement is singular.
   bool Build(const Model& model, double h, const std::vector<MatX>& rod_blocks,
-             const std::vector<BodySurface>& bodies, const std::vector<ClampBorder>* borders,
-             const std::vector<Matrix3X>* positions);
+             const std::vector<HydroRod>& rods, const std::vector<BodySurface>& bodies,
+             const std::vector<ClampBorder>* borders, bool coarse);
   /// out ≈ C⁻¹ v.
   void Apply(const VecX& v, VecX* out) const;
 
  private:
+  /// A diagonal block of the fine level: the unknowns of one rod, one body, or a cell (a body
+  /// and the rods clamped on it), which need not be contiguous.
+  struct Block {
+    std::vector<std::pair<int, int>> ranges;  ///< (first entry, size), in the block's order
+    int size = 0;
+    int rod = -1;   ///< a rod alone: its index
+    int body = -1;  ///< a body (and its rods): its index
+    DenseLu<float> lu;  ///< single precision: a preconditioner needs no more
+    VecX Gather(const VecX& v) const;
+    void Scatter(const Eigen::VectorXd& x, VecX* out) const;  ///< out(ranges) += x
+  };
+  /// Where a rod's or a body's unknowns sit: its block and its first entry in the block.
+  struct Place {
+    int block = 0;
+    int offset = 0;
+  };
   struct FreeBody {
-    int body = 0;             ///< index among the bodies
-    int unknown = 0;          ///< first entry of its V
+    int unknown = 0;  ///< first entry of its V
     // The columns B (3 × points of the body and of its clamped rods, × 6) and rows Cᵀ, with
-    // A⁻¹ B, each per block: first entry and the block's part.
-    std::vector<int> first;
+    // A⁻¹ B, per block they touch.
+    std::vector<int> blocks;
     std::vector<MatX> columns_solved;  ///< A⁻¹ B, per block
     std::vector<MatX> rows;            ///< Cᵀ, per block (6 × block size)
     Eigen::PartialPivLU<Mat6> schur;   ///< of Σ = K − Cᵀ A⁻¹ B
   };
+  void MakeBlocks(const Model& model, const std::vector<BodySurface>& bodies);
+  MatX BlockMatrix(const Model& model, double h, const Block& block,
+                   const std::vector<MatX>& rod_blocks, const std::vector<HydroRod>& rods,
+                   const std::vector<BodySurface>& bodies) const;
   void SolveBlocks(const VecX& v, VecX* out) const;
   void SolveFine(const VecX& v, VecX* out) const;
   bool BuildFreeBody(const Model& model, double h, int body, const std::vector<BodySurface>& bodies,
                      const std::vector<ClampBorder>* borders);
-  std::vector<int> block_first_;          ///< first entry of each block (rods, then bodies); back()
-  std::vector<DenseLu<float>> block_lu_;  ///< single precision: a preconditioner needs no more
+  std::vector<Block> blocks_;
+  std::vector<Place> rod_place_, body_place_;
   std::vector<FreeBody> free_bodies_;
   int size_ = 0;
   bool coarse_ = false;

@@ -161,7 +161,8 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
       std::vector<MatX> blocks(model.rods.size());
       for (std::size_t r = 0; r < model.rods.size(); ++r)
         blocks[r] = h * mobility_->SelfBlock(static_cast<int>(r)) + sx_blocks_[r];
-      if (!capacitance_blocks_.Build(model, h, blocks, bodies_, borders_, &positions_))
+      if (!capacitance_blocks_.Build(model, h, blocks, MakeHydroRods(model, positions_), bodies_,
+                                     borders_, true))
         return have_preconditioner_ = false;
     } else {
       MatX capacitance = h * *mobility_->matrix();
