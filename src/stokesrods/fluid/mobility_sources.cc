@@ -5,6 +5,7 @@
 
 #include "stokesrods/common/assert.h"
 #include "stokesrods/fluid/stokeslet_segment.h"
+#include "stokesrods/fluid/stokeslet_sum.h"
 #include "stokesrods/fluid/wall.h"
 
 namespace stokesrods {
@@ -17,6 +18,9 @@ class MobilityWithBodySources final : public MobilityOperator {
                           std::unique_ptr<MobilityOperator> rods_operator)
       : params_(params),
         accuracy_(std::max(options.tolerance, options.fast_sum_tolerance)),
+        sum_options_({.tolerance = options.fast_sum_tolerance,
+                      .direct_below_pairs = static_cast<std::int64_t>(options.direct_sum_below),
+                      .choose_by_cost = options.fast_sum_by_cost}),
         rods_operator_(std::move(rods_operator)) {
     SR_ASSERT(!params.wall, "bodies as sources: no wall images here (dense operator)");
   }
@@ -32,9 +36,11 @@ class MobilityWithBodySources final : public MobilityOperator {
 
  private:
   void AddRodsAtPoints(const VecX& force, VecX* velocity) const;
+  void BuildSums();
 
   FluidParams params_;
   double accuracy_;
+  StokesletSumOptions sum_options_;
   std::unique_ptr<MobilityOperator> rods_operator_;
   std::vector<HydroRod> rods_;
   std::vector<BodySurface> bodies_;
@@ -42,7 +48,9 @@ class MobilityWithBodySources final : public MobilityOperator {
   VecX inverse_voronoi_;         // 1/Λ_j
   Matrix3X points_;              // 3 × P
   VecX point_eps_;               // the bodies' blobs ε
-  MatX body_block_;              // bodies ← bodies (3P × 3P)
+  std::unique_ptr<StokesletSum> at_points_;  // rods' Gauss points and body points → body points
+  std::unique_ptr<StokesletSum> at_nodes_;   // body points → rod nodes
+  int num_gauss_ = 0;
   NearBlocks near_;              // of the rods at the body points (the rods' operator's)
 };
 
@@ -72,53 +80,63 @@ void MobilityWithBodySources::UpdateWithBodies(const std::vector<HydroRod>& rods
     point_eps_.segment(k, b.points.cols()).setConstant(b.regularization);
     k += static_cast<int>(b.points.cols());
   }
-  const double scale = 1.0 / (8.0 * kPi * params_.viscosity);
-  body_block_.resize(3 * num_body_points_, 3 * num_body_points_);
-#pragma omp parallel for schedule(static)
-  for (int j = 0; j < num_body_points_; ++j)
-    for (int i = 0; i < num_body_points_; ++i)
-      body_block_.block<3, 3>(3 * i, 3 * j) =
-          scale * PointBlobMatrix(nullptr, points_.col(i), points_.col(j), point_eps_(j));
+  BuildSums();
   rods_operator_->FindNearBlocks(points_, &near_);
 }
 
-// velocity (at the body points) += the rods' segments: the far rule at every segment, summed
-// directly, plus the near blocks.
+// The far-field sums of the bodies' points (fluid/stokeslet_sum.h, the rods' operator's fast sum
+// options): at the body points, every rod segment by the split's Gauss rule (the near blocks
+// correct the near ones) and every body point; at the rod nodes, every body point.
+void MobilityWithBodySources::BuildSums() {
+  const int g = rods_operator_->cost_counts().gauss_points;  // the rods' rule, as in their near blocks
+  const double* alpha = nullptr;
+  const double* weight = nullptr;
+  GaussLegendreRule01(g, &alpha, &weight);
+  const int m = node_offset(num_rods());
+  num_gauss_ = g * (m - num_rods());
+  Matrix3X sources(3, num_gauss_ + num_body_points_);
+  VecX eps(num_gauss_ + num_body_points_);
+  int k = 0;
+  for (int r = 0; r < num_rods(); ++r)
+    for (int a = node_offset(r); a + 1 < node_offset(r + 1); ++a)
+      for (int q = 0; q < g; ++q, ++k) {
+        sources.col(k) = nodes_.col(a) + alpha[q] * (nodes_.col(a + 1) - nodes_.col(a));
+        eps(k) = params_.regularization * rods_[static_cast<size_t>(r)].radius;
+      }
+  sources.rightCols(num_body_points_) = points_;
+  eps.tail(num_body_points_) = point_eps_;
+  at_points_ = MakeFastStokesletSum(sum_options_);
+  at_points_->Build(sources, eps, points_);
+  at_nodes_ = MakeFastStokesletSum(sum_options_);
+  at_nodes_->Build(points_, point_eps_, nodes_);
+}
+
+// velocity (at the body points) += the rods' segments (the far rule at every segment plus the
+// near blocks) and the bodies' points.
 void MobilityWithBodySources::AddRodsAtPoints(const VecX& force, VecX* velocity) const {
   const int g = rods_operator_->cost_counts().gauss_points;  // the rods' rule, as in their near blocks
   const double* alpha = nullptr;
   const double* weight = nullptr;
   GaussLegendreRule01(g, &alpha, &weight);
-  // The rule's points and strengths w_q L ((1 − α_q) f_a + α_q f_b), f = F/Λ, with their ε².
-  std::vector<Vec3> where, strength;
-  std::vector<double> eps2;
-  for (int r = 0; r < num_rods(); ++r) {
-    const double eps = params_.regularization * rods_[static_cast<size_t>(r)].radius;
+  // The rule's strengths w_q L ((1 − α_q) f_a + α_q f_b), f = F/Λ, then the points' forces.
+  const int m = node_offset(num_rods());
+  Matrix3X strength(3, num_gauss_ + num_body_points_);
+  int k = 0;
+  for (int r = 0; r < num_rods(); ++r)
     for (int a = node_offset(r); a + 1 < node_offset(r + 1); ++a) {
-      const Vec3 xa = nodes_.col(a), xb = nodes_.col(a + 1);
       const Vec3 fa = force.segment<3>(3 * a) * inverse_voronoi_(a);
       const Vec3 fb = force.segment<3>(3 * (a + 1)) * inverse_voronoi_(a + 1);
-      for (int q = 0; q < g; ++q) {
-        where.push_back(xa + alpha[q] * (xb - xa));
-        strength.push_back((weight[q] * (xb - xa).norm()) * ((1.0 - alpha[q]) * fa + alpha[q] * fb));
-        eps2.push_back(eps * eps);
-      }
+      const double length = (nodes_.col(a + 1) - nodes_.col(a)).norm();
+      for (int q = 0; q < g; ++q, ++k)
+        strength.col(k) = (weight[q] * length) * ((1.0 - alpha[q]) * fa + alpha[q] * fb);
     }
-  }
+  for (int j = 0; j < num_body_points_; ++j) strength.col(k + j) = force.segment<3>(3 * (m + j));
+  Matrix3X w;
+  at_points_->Apply(strength, &w);
   const double scale = 1.0 / (8.0 * kPi * params_.viscosity);
-  const int m = node_offset(num_rods());
 #pragma omp parallel for schedule(static)
-  for (int t = 0; t < num_body_points_; ++t) {
-    const Vec3 p = points_.col(t);
-    Vec3 u = Vec3::Zero();
-    for (std::size_t k = 0; k < where.size(); ++k) {
-      const Vec3 r = p - where[k];
-      const double inv = 1.0 / std::sqrt(r.squaredNorm() + eps2[k]);
-      const double inv3 = inv * inv * inv;
-      u += (inv + eps2[k] * inv3) * strength[k] + (inv3 * r.dot(strength[k])) * r;
-    }
-    velocity->segment<3>(3 * (m + t)) += scale * u + near_.At(t, force);
-  }
+  for (int t = 0; t < num_body_points_; ++t)
+    velocity->segment<3>(3 * (m + t)) += scale * w.col(t) + near_.At(t, force);
 }
 
 void MobilityWithBodySources::Apply(const VecX& force, VecX* velocity) const {
@@ -128,19 +146,14 @@ void MobilityWithBodySources::Apply(const VecX& force, VecX* velocity) const {
   if (m > 0) rods_operator_->Apply(force.head(3 * m), &rods_velocity);
   velocity->setZero(size());
   velocity->head(3 * m) = rods_velocity;
-  const double scale = 1.0 / (8.0 * kPi * params_.viscosity);
-  // The bodies' blobs at the rod nodes, summed directly.
-#pragma omp parallel for schedule(static)
-  for (int i = 0; i < m; ++i) {
-    Vec3 u = Vec3::Zero();
-    for (int j = 0; j < p; ++j)
-      u += PointBlobMatrix(nullptr, nodes_.col(i), points_.col(j), point_eps_(j)) *
-           force.segment<3>(3 * (m + j));
-    velocity->segment<3>(3 * i) += scale * u;
-  }
   if (p == 0) return;
+  // The bodies' blobs at the rod nodes; the rods and the bodies at the body points.
+  if (m > 0) {
+    Matrix3X w;
+    at_nodes_->Apply(Eigen::Map<const Matrix3X>(force.data() + 3 * m, 3, p), &w);
+    velocity->head(3 * m) += Eigen::Map<const VecX>(w.data(), 3 * m) / (8.0 * kPi * params_.viscosity);
+  }
   AddRodsAtPoints(force, velocity);
-  velocity->segment(3 * m, 3 * p) += body_block_ * force.segment(3 * m, 3 * p);
   // The free bodies' border: G V on their points, Gᵀ f in their rows.
   int point = m, mode = 3 * (m + p);
   for (const BodySurface& b : bodies_) {

@@ -4,14 +4,16 @@
 // The unknowns are those of AssembleBorderedMobility: the rods' M nodal forces, the bodies' P
 // point forces, then (U, Ω) of each free body. The product is assembled from its blocks:
 //   rods ← rods    the rods' own operator (matrix-free: near closed forms + far Gauss sum);
-//   rods ← bodies  the bodies' regularized point Stokeslets at the rod nodes, summed directly
-//                  (O(M P) per product, no storage);
+//   rods ← bodies  the bodies' regularized point Stokeslets at the rod nodes;
 //   bodies ← rods  the rods' segments at the body points, as the matrix-free operator does it:
-//                  the far field by the same Gauss rule summed directly at the P points, the
-//                  segments near a point (δ below the split's near radius) by their closed forms
-//                  minus that rule, stored as 3 × 3 blocks (O(P × near segments)), found by the
-//                  rods' operator as at its own nodes (MobilityOperator::FindNearBlocks);
-//   bodies ← bodies  dense (3P × 3P), assembled at each update;
+//                  the far field by the same Gauss rule at the P points, the segments near a
+//                  point (δ below the split's near radius) by their closed forms minus that rule,
+//                  stored as 3 × 3 blocks (O(P × near segments)), found by the rods' operator as
+//                  at its own nodes (MobilityOperator::FindNearBlocks);
+//   bodies ← bodies  the points' regularized Stokeslets;
+//   the point sums by the rods' operator's fast sum (fluid/stokeslet_sum.h, its options: direct
+//   below direct_sum_below pairs, else the FMM where it pays), two per update: {Gauss points,
+//   body points} at the body points, body points at the rod nodes; nothing O(P²) stored;
 //   the free bodies' border, G V on their points' rows and Gᵀ f in their six rows.
 // Its accuracy is the rods' operator's: every far segment–point pair by the rule the split
 // chooses for max(tolerance, fast_sum_tolerance) (tests/fluid/mobility_sources_test.cc: against
