@@ -46,46 +46,149 @@ MatX BandedMatrix::ToDense() const {
   return a;
 }
 
+namespace {
+
+// The kernels below work on LAPACK's band storage (see the header): A(i, j) at
+// ab[(2kd + i − j) + j·ldab], ldab = 3kd + 1. Each is a template over the half bandwidth, KD > 0
+// fixed at compile time (the rods' 10: every inner loop a fixed trip count, unrolled and
+// vectorized) or KD = 0 taken from `kd` at run time, inlined into functions cloned for AVX-512,
+// AVX2 and the baseline (the build targets baseline x86-64; the loader picks the clone).
+// Rows with fewer than KD entries below the diagonal (the last KD) take the run-time loops.
+
+// y[0, count) −= a · x[0, count), with count = KD when the column is whole.
+template <int KD>
+inline __attribute__((always_inline)) void Axpy(int count, double a, const double* x, double* y) {
+  if (KD > 0 && count == KD) {
+#pragma omp simd
+    for (int i = 0; i < KD; ++i) y[i] -= a * x[i];
+  } else {
+#pragma omp simd
+    for (int i = 0; i < count; ++i) y[i] -= a * x[i];
+  }
+}
+
 // LU with partial pivoting, the algorithm of LAPACK's dgbtf2 in its storage (U in rows 0..2kd
-// with the fill of the row interchanges, the multipliers of L in rows 2kd+1..3kd). Written here
-// rather than called: at half bandwidth 10 each of LAPACK's level-2 calls (idamax, dswap, dscal,
-// dger per column; dtbsv and dger per solve) moves a few dozen numbers, and the call overhead
-// was ~10× the arithmetic (callgrind: 270k instructions per solve of a 260-DOF rod against ~8k
-// multiply–adds). Checked against a dense LU in tests/solver/banded_matrix_test.cc.
-bool BandedMatrix::Factorize() {
-  SR_ASSERT(!factorized_, "matrix factorized twice");
-  factorized_ = true;
-  const int kv = 2 * kd_;  // the row of the diagonal in the band storage
+// with the fill of the row interchanges, the multipliers of L in rows 2kd+1..3kd).
+template <int KD>
+inline __attribute__((always_inline)) bool FactorizeBand(int n, int kd_runtime, double* ab,
+                                                         int* pivots) {
+  const int kd = KD > 0 ? KD : kd_runtime, kv = 2 * kd, ldab = 3 * kd + 1;
+  auto at = [&](int i, int j) -> double& {
+    return ab[(kv + i - j) + static_cast<std::ptrdiff_t>(j) * ldab];
+  };
   // The fill region (kd < j − i ≤ 2kd) must start at zero.
-  for (int j = kd_ + 1; j < n_; ++j)
-    for (int i = std::max(0, j - kv); i < j - kd_; ++i) (*this)(i, j) = 0.0;
+  for (int j = kd + 1; j < n; ++j)
+    for (int i = std::max(0, j - kv); i < j - kd; ++i) at(i, j) = 0.0;
   bool regular = true;
   int last_column = 0;  // the last column the pivots so far reach
-  for (int j = 0; j < n_; ++j) {
-    const int below = std::min(kd_, n_ - 1 - j);
-    double* column = &ab_[static_cast<std::size_t>(kv + j * ldab_)];  // column[i] = A(j + i, j)
+  for (int j = 0; j < n; ++j) {
+    const int below = std::min(kd, n - 1 - j);
+    double* column = &at(j, j);  // column[i] = A(j + i, j)
     int p = 0;
     for (int i = 1; i <= below; ++i)
       if (std::abs(column[i]) > std::abs(column[p])) p = i;
-    pivots_[static_cast<std::size_t>(j)] = j + p;
+    pivots[j] = j + p;
     if (column[p] == 0.0) {
       regular = false;
       continue;
     }
-    last_column = std::max(last_column, std::min(j + kd_ + p, n_ - 1));
+    last_column = std::max(last_column, std::min(j + kd + p, n - 1));
     if (p != 0)
-      for (int c = j; c <= last_column; ++c) std::swap((*this)(j, c), (*this)(j + p, c));
+      for (int c = j; c <= last_column; ++c) std::swap(at(j, c), at(j + p, c));
     if (below == 0) continue;
     const double inverse_pivot = 1.0 / column[0];
     for (int i = 1; i <= below; ++i) column[i] *= inverse_pivot;
     for (int c = j + 1; c <= last_column; ++c) {
-      double* target = &(*this)(j, c);  // target[i] = A(j + i, c)
-      const double a_jc = target[0];
-      if (a_jc == 0.0) continue;
-      Eigen::Map<VecX>(target + 1, below) -= a_jc * Eigen::Map<const VecX>(column + 1, below);
+      double* target = &at(j, c);  // target[i] = A(j + i, c)
+      if (target[0] != 0.0) Axpy<KD>(below, target[0], column + 1, target + 1);
     }
   }
   return regular;
+}
+
+// One right-hand side x (n) in place.
+template <int KD>
+inline __attribute__((always_inline)) void SolveBand(int n, int kd_runtime, const double* ab,
+                                                     const int* pivots, double* x) {
+  const int kd = KD > 0 ? KD : kd_runtime, kv = 2 * kd, ldab = 3 * kd + 1;
+  // L: the row interchanges and multipliers in the order they were made.
+  for (int j = 0; j + 1 < n; ++j) {
+    const int p = pivots[j];
+    if (p != j) std::swap(x[j], x[p]);
+    if (x[j] == 0.0) continue;
+    const double* column = ab + kv + static_cast<std::ptrdiff_t>(j) * ldab;  // A(j + i, j)
+    Axpy<KD>(std::min(kd, n - 1 - j), x[j], column + 1, x + j + 1);
+  }
+  // U: upper triangular with bandwidth 2kd, by columns from the last.
+  for (int j = n - 1; j >= 0; --j) {
+    const double* column = ab + static_cast<std::ptrdiff_t>(j) * ldab;  // A(j − kv + r, j)
+    x[j] /= column[kv];
+    const int top = std::max(0, j - kv);
+    constexpr int kUpper = KD > 0 ? 2 * KD : 0;
+    Axpy<kUpper>(j - top, x[j], column + kv + top - j, x + top);
+  }
+}
+
+// num_rhs right-hand sides stored by rows (x(i, k) at x[i · num_rhs + k]): each row operation one
+// long vector operation across them.
+template <int KD>
+inline __attribute__((always_inline)) void SolveBandRows(int n, int kd_runtime, const double* ab,
+                                                         const int* pivots, int num_rhs,
+                                                         double* x) {
+  const int kd = KD > 0 ? KD : kd_runtime, kv = 2 * kd, ldab = 3 * kd + 1;
+  auto row = [&](int i) { return x + static_cast<std::ptrdiff_t>(i) * num_rhs; };
+  auto subtract = [num_rhs](double a, const double* from, double* to) {
+#pragma omp simd
+    for (int k = 0; k < num_rhs; ++k) to[k] -= a * from[k];
+  };
+  for (int j = 0; j + 1 < n; ++j) {
+    const int p = pivots[j];
+    if (p != j) std::swap_ranges(row(j), row(j) + num_rhs, row(p));
+    const double* column = ab + kv + static_cast<std::ptrdiff_t>(j) * ldab;
+    for (int i = 1; i <= std::min(kd, n - 1 - j); ++i)
+      if (column[i] != 0.0) subtract(column[i], row(j), row(j + i));
+  }
+  for (int j = n - 1; j >= 0; --j) {
+    const double* column = ab + static_cast<std::ptrdiff_t>(j) * ldab;
+    const double inverse = 1.0 / column[kv];
+    for (int k = 0; k < num_rhs; ++k) row(j)[k] *= inverse;
+    for (int i = std::max(0, j - kv); i < j; ++i)
+      if (column[kv + i - j] != 0.0) subtract(column[kv + i - j], row(j), row(i));
+  }
+}
+
+// The rods' half bandwidth (the bending stencil's 11 DOFs), compiled with a fixed trip count.
+constexpr int kRodHalfBandwidth = 10;
+
+__attribute__((target_clones("avx512f", "avx2", "default")))
+bool Factorize(int n, int kd, double* ab, int* pivots) {
+  return kd == kRodHalfBandwidth ? FactorizeBand<kRodHalfBandwidth>(n, kd, ab, pivots)
+                                 : FactorizeBand<0>(n, kd, ab, pivots);
+}
+
+__attribute__((target_clones("avx512f", "avx2", "default")))
+void Solve(int n, int kd, const double* ab, const int* pivots, double* x) {
+  if (kd == kRodHalfBandwidth) return SolveBand<kRodHalfBandwidth>(n, kd, ab, pivots, x);
+  SolveBand<0>(n, kd, ab, pivots, x);
+}
+
+__attribute__((target_clones("avx512f", "avx2", "default")))
+void SolveRows(int n, int kd, const double* ab, const int* pivots, int num_rhs, double* x) {
+  if (kd == kRodHalfBandwidth) return SolveBandRows<kRodHalfBandwidth>(n, kd, ab, pivots, num_rhs, x);
+  SolveBandRows<0>(n, kd, ab, pivots, num_rhs, x);
+}
+
+}  // namespace
+
+// Written here rather than called: at half bandwidth 10 each of LAPACK's level-2 calls (idamax,
+// dswap, dscal, dger per column; dtbsv and dger per solve) moves a few dozen numbers, and the
+// call overhead was ~10× the arithmetic (callgrind: 270k instructions per solve of a 260-DOF rod
+// against ~8k multiply–adds). Checked against LAPACK and a dense LU in
+// tests/solver/banded_matrix_test.cc.
+bool BandedMatrix::Factorize() {
+  SR_ASSERT(!factorized_, "matrix factorized twice");
+  factorized_ = true;
+  return stokesrods::Factorize(n_, kd_, ab_.data(), pivots_.data());
 }
 
 void BandedMatrix::Solve(double* b, int num_rhs) const {
@@ -94,48 +197,15 @@ void BandedMatrix::Solve(double* b, int num_rhs) const {
     SolveManyRows(b, num_rhs);
     return;
   }
-  const int kv = 2 * kd_;
-  for (int k = 0; k < num_rhs; ++k) {
-    double* x = b + static_cast<std::ptrdiff_t>(k) * n_;
-    // L: the row interchanges and multipliers in the order they were made.
-    for (int j = 0; j + 1 < n_; ++j) {
-      const int p = pivots_[static_cast<std::size_t>(j)];
-      if (p != j) std::swap(x[j], x[p]);
-      const double xj = x[j];
-      if (xj == 0.0) continue;
-      const int below = std::min(kd_, n_ - 1 - j);
-      const double* column = &ab_[static_cast<std::size_t>(kv + j * ldab_)];  // A(j + i, j)
-      Eigen::Map<VecX>(x + j + 1, below) -= xj * Eigen::Map<const VecX>(column + 1, below);
-    }
-    // U: upper triangular with bandwidth 2kd, by columns from the last.
-    for (int j = n_ - 1; j >= 0; --j) {
-      const double* column = &ab_[static_cast<std::size_t>(j * ldab_)];  // A(j − kv + r, j)
-      x[j] /= column[kv];
-      const double xj = x[j];
-      const int top = std::max(0, j - kv);
-      Eigen::Map<VecX>(x + top, j - top) -= xj * Eigen::Map<const VecX>(column + kv + top - j, j - top);
-    }
-  }
+  for (int k = 0; k < num_rhs; ++k)
+    stokesrods::Solve(n_, kd_, ab_.data(), pivots_.data(), b + static_cast<std::ptrdiff_t>(k) * n_);
 }
 
 void BandedMatrix::SolveManyRows(double* b, int num_rhs) const {
   using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   Eigen::Map<MatX> columns(b, n_, num_rhs);
   RowMajor x = columns;
-  const int kv = 2 * kd_;
-  for (int j = 0; j + 1 < n_; ++j) {
-    const int p = pivots_[static_cast<std::size_t>(j)];
-    if (p != j) x.row(j).swap(x.row(p));
-    const double* column = &ab_[static_cast<std::size_t>(kv + j * ldab_)];
-    for (int i = 1; i <= std::min(kd_, n_ - 1 - j); ++i)
-      if (column[i] != 0.0) x.row(j + i) -= column[i] * x.row(j);
-  }
-  for (int j = n_ - 1; j >= 0; --j) {
-    const double* column = &ab_[static_cast<std::size_t>(j * ldab_)];
-    x.row(j) /= column[kv];
-    for (int i = std::max(0, j - kv); i < j; ++i)
-      if (column[kv + i - j] != 0.0) x.row(i) -= column[kv + i - j] * x.row(j);
-  }
+  SolveRows(n_, kd_, ab_.data(), pivots_.data(), num_rhs, x.data());
   columns = x;
 }
 
