@@ -97,6 +97,19 @@ TEST(MobilityReuse, LargeStepsAssembleEveryTime) {
   EXPECT_EQ(o.stats.largest_error, 0.0);
 }
 
+// The history is kept in single precision (6e-8 relative): a tolerance below what that rounding
+// allows assembles at every step, exact, even where the motion is slow enough for a double
+// history to be extrapolated; a tolerance above it reuses 𝕄 on the same motion, within it.
+TEST(MobilityReuse, TolerancesBelowSinglePrecisionAssembleEveryTime) {
+  const Outcome fine = Turn(1e-8, 1e-6, 30);
+  EXPECT_EQ(fine.stats.assemblies, 30);
+  EXPECT_EQ(fine.worst_error, 0.0);
+  const Outcome coarse = Turn(1e-5, 1e-6, 30);
+  EXPECT_LT(coarse.stats.assemblies, 30 / 2);
+  EXPECT_GT(coarse.worst_error, 0.0);
+  EXPECT_LT(coarse.worst_error, 1.5e-5);
+}
+
 TEST(MobilityReuse, ToleranceZeroAssemblesEveryTime) {
   const Outcome o = Turn(0.0, 1.6e-3, 30);
   EXPECT_EQ(o.stats.assemblies, 30);

@@ -52,12 +52,15 @@ class DenseMobility final : public MobilityOperator {
     for (int r = 0; r < num_rods(); ++r)
       x.segment(3 * node_offset(r), 3 * rods[static_cast<size_t>(r)].x->cols()) =
           rods[static_cast<size_t>(r)].x->reshaped();
-    reuse_.Update(x, [&](MatX* m) { AssembleMobility(params_, rods, m); }, &matrix_);
+    single_current_ =
+        !reuse_.Update(x, [&](MatX* m) { AssembleMobility(params_, rods, m); }, &matrix_, &single_);
+    double_stale_ = single_current_;
   }
   void UpdateWithBodies(const std::vector<HydroRod>& rods,
                         const std::vector<BodySurface>& bodies) override {
     if (bodies.empty()) return Update(rods);  // every fluid model
     reuse_.Forget();  // bodies: assembled at every Update
+    single_current_ = double_stale_ = false;
     SetLayout(rods);
     for (const BodySurface& b : bodies) {
       num_body_points_ += static_cast<int>(b.points.cols());
@@ -69,25 +72,37 @@ class DenseMobility final : public MobilityOperator {
   MobilityReuseStats reuse_stats() const override { return reuse_.stats(); }
   void Apply(const VecX& force, VecX* velocity) const override {
     // Row blocks in parallel: the product streams the whole matrix (memory bound beyond cache).
-    const Eigen::Index n = matrix_.rows();
+    const Eigen::Index n = single_current_ ? single_.rows() : matrix_.rows();
     velocity->resize(n);
     constexpr Eigen::Index kRows = 192;
 #pragma omp parallel for schedule(static) if (n > 2 * kRows)
     for (Eigen::Index first = 0; first < n; first += kRows) {
       const Eigen::Index rows = std::min(kRows, n - first);
-      GemvRows(matrix_, first, rows, force.data(), velocity->data() + first);
+      if (single_current_)
+        GemvRowsMixed(single_, first, rows, force.data(), velocity->data() + first);
+      else
+        GemvRows(matrix_, first, rows, force.data(), velocity->data() + first);
     }
   }
   MatX SelfBlock(int rod) const override {
     const int first = 3 * node_offset(rod), n = 3 * (node_offset(rod + 1) - node_offset(rod));
+    if (single_current_) return single_.block(first, first, n, n).cast<double>();
     return matrix_.block(first, first, n, n);
   }
-  const MatX* matrix() const override { return &matrix_; }
+  // An extrapolated 𝕄 (single precision) is converted on demand: the capacitance's rebuilds and
+  // the explicit coupling's LU, not the products, read it in double.
+  const MatX* matrix() const override {
+    if (double_stale_) matrix_ = single_.cast<double>(), double_stale_ = false;
+    return &matrix_;
+  }
 
  private:
   FluidParams params_;
   MobilityReuse reuse_;
-  MatX matrix_;
+  mutable MatX matrix_;          // assembled (or converted from single_ on demand)
+  Eigen::MatrixXf single_;       // extrapolated by the reuse (fluid/mobility_reuse.h)
+  bool single_current_ = false;  // the last Update extrapolated: single_ is 𝕄
+  mutable bool double_stale_ = false;  // matrix_ is not single_ yet
 };
 
 // Matrix-free RSS (see the header). With f_j = F_j/Λ_j the force densities at the nodes,

@@ -5,31 +5,32 @@
 
 namespace stokesrods {
 
-void MobilityReuse::Update(const VecX& x, const std::function<void(MatX*)>& assemble,
-                           MatX* matrix) {
+bool MobilityReuse::Update(const VecX& x, const std::function<void(MatX*)>& assemble,
+                           MatX* assembled, Eigen::MatrixXf* extrapolated) {
   ++stats_.updates;
   if (tolerance_ <= 0.0) {
-    assemble(matrix);
+    assemble(assembled);
     ++stats_.assemblies;
-    return;
+    return true;
   }
   const bool same_size = base_x_.size() == x.size();
   if (history_ == 2 && same_size && since_ + 1 < interval_) {
     ++since_;
-    const double s = Projection(x);
-    matrix->resize(base_.rows(), base_.cols());
-    matrix->noalias() = base_ + s * slope_;
-    return;
+    const auto s = static_cast<float>(Projection(x));
+    extrapolated->resize(base_.rows(), base_.cols());
+    extrapolated->noalias() = base_ + s * slope_;
+    return false;
   }
   if (!same_size) history_ = 0;
-  assemble(matrix);
+  assemble(assembled);
   ++stats_.assemblies;
   if (history_ == 2) {
     // What the extrapolation gives here, since_ + 1 updates from base_ (one more than the
-    // farthest used since base_, so it bounds them).
+    // farthest used since base_, so it bounds them), rounding included.
     const double s = Projection(x);
     const double error =
-        (base_ + s * slope_ - *matrix).norm() / std::max(matrix->norm(), 1e-300);
+        (base_.cast<double>() + s * slope_.cast<double>() - *assembled).norm() /
+        std::max(assembled->norm(), 1e-300);
     if (since_ > 0) stats_.largest_error = std::max(stats_.largest_error, error);
     const int used = since_ + 1;
     const double grow = error > 0.0 ? 0.9 * std::sqrt(tolerance_ / error) : 2.0;
@@ -37,13 +38,15 @@ void MobilityReuse::Update(const VecX& x, const std::function<void(MatX*)>& asse
                            kMaxInterval);
   }
   if (history_ >= 1) {
-    slope_ = *matrix - base_;
+    slope_ = (*assembled - last_assembled_).cast<float>();
     step_x_ = x - base_x_;
   }
-  base_ = *matrix;
+  last_assembled_ = *assembled;
+  base_ = assembled->cast<float>();
   base_x_ = x;
   history_ = std::min(history_ + 1, 2);
   since_ = 0;
+  return true;
 }
 
 void MobilityReuse::Forget() {

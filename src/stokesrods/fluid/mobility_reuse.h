@@ -16,6 +16,12 @@
 // A large step (e(1) > 0.2 tolerance) assembles at every step, exactly as without reuse. Forget
 // drops the history (a restart point: the next steps then depend on the state alone). The largest e
 // measured is kept in the statistics (an interval is shortened after the fact, not redone).
+//
+// PRECISION. An assembled 𝕄 is given as it is (double). The history 𝕄_b, 𝕄_b − 𝕄_a and the
+// extrapolated 𝕄 are kept in single precision: their rounding (6e-8 relative) is part of the e
+// measured, and below a tolerance of about 3e-7 (e(1) > 0.2 tolerance from the rounding alone) 𝕄
+// is simply assembled at every step. The extrapolated matrix streams half the bytes of a double
+// one in the products, which sum in double (solver/blas.h GemvRowsMixed).
 #pragma once
 
 #include <functional>
@@ -37,9 +43,11 @@ class MobilityReuse {
 
   explicit MobilityReuse(double tolerance) : tolerance_(tolerance) {}
 
-  /// 𝕄 at the node positions x (3M) into `matrix`: by `assemble` (which writes 𝕄(x) into its
-  /// argument), or extrapolated. With tolerance 0 it always assembles.
-  void Update(const VecX& x, const std::function<void(MatX*)>& assemble, MatX* matrix);
+  /// 𝕄 at the node positions x (3M): assembled by `assemble` (which writes 𝕄(x) into its
+  /// argument) into `assembled` (returns true), or extrapolated into `extrapolated` (single
+  /// precision; returns false). With tolerance 0 it always assembles.
+  bool Update(const VecX& x, const std::function<void(MatX*)>& assemble, MatX* assembled,
+              Eigen::MatrixXf* extrapolated);
   /// Drops the history: the next Update assembles.
   void Forget();
   const MobilityReuseStats& stats() const { return stats_; }
@@ -51,8 +59,9 @@ class MobilityReuse {
   int history_ = 0;    ///< assemblies since Forget (0, 1, 2 = base and slope known)
   int since_ = 0;      ///< updates since the last assembly
   int interval_ = 1;   ///< updates from one assembly to the next
-  MatX base_;          ///< 𝕄_b
-  MatX slope_;         ///< 𝕄_b − 𝕄_a
+  Eigen::MatrixXf base_;   ///< 𝕄_b
+  Eigen::MatrixXf slope_;  ///< 𝕄_b − 𝕄_a (rounded once, from double)
+  MatX last_assembled_;    ///< 𝕄_b in double
   VecX base_x_;        ///< x_b
   VecX step_x_;        ///< x_b − x_a
   MobilityReuseStats stats_;

@@ -19,4 +19,10 @@ void GemvRows(const Eigen::MatrixXd& a, Eigen::Index first, Eigen::Index rows, c
 void GemvRows(const Eigen::MatrixXf& a, Eigen::Index first, Eigen::Index rows, const float* x,
               float* y);
 
+/// y = A x for rows [first, first + rows) of a single-precision matrix, with x, y and the sums in
+/// double (gemv_mixed.cc: AVX-512 where the CPU has it; `portable` forces the plain loop, for
+/// tests). Each row's sum in one fixed order: independent of how rows are split over threads.
+void GemvRowsMixed(const Eigen::MatrixXf& a, Eigen::Index first, Eigen::Index rows, const double* x,
+                   double* y, bool portable = false);
+
 }  // namespace stokesrods
