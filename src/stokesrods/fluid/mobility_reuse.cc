@@ -4,6 +4,34 @@
 #include <cmath>
 
 namespace stokesrods {
+namespace {
+
+// The extrapolation's two passes over the matrices, as plain loops vectorized for the CPU at hand
+// (the build targets baseline x86-64, where Eigen's expressions use SSE2 only; GCC 12 at -O2
+// vectorizes only loops marked `omp simd`). Each runs once per step or per assembly over all
+// 9M² entries and was 10 % of Fig. 1's step as Eigen expressions.
+
+// out = base + s · slope (n entries).
+__attribute__((target_clones("avx512f", "avx2", "default")))
+void Extrapolate(Eigen::Index n, const float* base, float s, const float* slope, float* out) {
+#pragma omp simd
+  for (Eigen::Index i = 0; i < n; ++i) out[i] = base[i] + s * slope[i];
+}
+
+// Σ (base + s · slope − exact)², in double.
+__attribute__((target_clones("avx512f", "avx2", "default")))
+double SquaredMiss(Eigen::Index n, const float* base, double s, const float* slope,
+                   const double* exact) {
+  double sum = 0.0;
+#pragma omp simd reduction(+ : sum)
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double d = static_cast<double>(base[i]) + s * static_cast<double>(slope[i]) - exact[i];
+    sum += d * d;
+  }
+  return sum;
+}
+
+}  // namespace
 
 bool MobilityReuse::Update(const VecX& x, const std::function<void(MatX*)>& assemble,
                            MatX* assembled, Eigen::MatrixXf* extrapolated) {
@@ -18,7 +46,7 @@ bool MobilityReuse::Update(const VecX& x, const std::function<void(MatX*)>& asse
     ++since_;
     const auto s = static_cast<float>(Projection(x));
     extrapolated->resize(base_.rows(), base_.cols());
-    extrapolated->noalias() = base_ + s * slope_;
+    Extrapolate(base_.size(), base_.data(), s, slope_.data(), extrapolated->data());
     return false;
   }
   if (!same_size) history_ = 0;
@@ -29,7 +57,7 @@ bool MobilityReuse::Update(const VecX& x, const std::function<void(MatX*)>& asse
     // farthest used since base_, so it bounds them), rounding included.
     const double s = Projection(x);
     const double error =
-        (base_.cast<double>() + s * slope_.cast<double>() - *assembled).norm() /
+        std::sqrt(SquaredMiss(base_.size(), base_.data(), s, slope_.data(), assembled->data())) /
         std::max(assembled->norm(), 1e-300);
     if (since_ > 0) stats_.largest_error = std::max(stats_.largest_error, error);
     const int used = since_ + 1;
