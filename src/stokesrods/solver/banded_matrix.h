@@ -63,6 +63,7 @@ class BandedMatrix {
   int ldab_ = 1;
   std::vector<double> ab_;
   std::vector<int> pivots_;
+  std::vector<double> inverse_diagonal_;  // 1/U(j, j) after Factorize
   bool factorized_ = false;
 };
 
