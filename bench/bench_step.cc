@@ -14,6 +14,7 @@
 #include "stokesrods/sim/elastic_assembly.h"
 #include "stokesrods/sim/hydro_coupling.h"
 #include "stokesrods/sim/integrator.h"
+#include "stokesrods/solver/blas.h"
 
 extern "C" {  // LAPACK's banded LU, the reference BandedMatrix replaced (OpenBLAS)
 void dgbtrf_(const int* m, const int* n, const int* kl, const int* ku, double* ab,
@@ -70,6 +71,19 @@ void BM_ElasticForcesAndJacobian(benchmark::State& st) {
 BENCHMARK(BM_ElasticForcesAndJacobian)->RangeMultiplier(4)->Range(64, 4096)
     ->Complexity(benchmark::oN)->Unit(benchmark::kMicrosecond);
 
+// The forces alone (the Newton test's evaluation at each trial point).
+void BM_ElasticForces(benchmark::State& st) {
+  const Model model = PaperModel(1, static_cast<int>(st.range(0)), "none", "implicit");
+  const State rest = MakeRestState(model);
+  VecX force(model.num_dofs);
+  for (auto _ : st) {
+    force.setZero();
+    AddElasticForces(model.rods[0], rest.q, rest.rods[0], &force, nullptr);
+    benchmark::DoNotOptimize(force.data());
+  }
+}
+BENCHMARK(BM_ElasticForces)->Arg(64)->Unit(benchmark::kMicrosecond);
+
 // The banded Newton matrix of one rod (N nodes, 4N − 1 DOFs, half bandwidth 10): LU and one solve.
 BandedMatrix RandomRodJacobian(int nodes) {
   std::mt19937 rng(3);
@@ -117,6 +131,25 @@ void BM_BandedSolveMany(benchmark::State& st) {
   }
 }
 BENCHMARK(BM_BandedSolveMany)->Arg(65)->Unit(benchmark::kMicrosecond);
+
+// A product with Fig. 1's 𝕄 (3M = 390): the double matrix (OpenBLAS dgemv) and the reused,
+// single-precision one with double sums (solver/gemv_mixed.cc).
+void BM_MobilityProduct(benchmark::State& st, bool single) {
+  const int n = 390;
+  const MatX a = MatX::Random(n, n);
+  const Eigen::MatrixXf af = a.cast<float>();
+  const VecX x = VecX::Random(n);
+  VecX y(n);
+  for (auto _ : st) {
+    if (single)
+      GemvRowsMixed(af, 0, n, x.data(), y.data());
+    else
+      GemvRows(a, 0, n, x.data(), y.data());
+    benchmark::DoNotOptimize(y.data());
+  }
+}
+BENCHMARK_CAPTURE(BM_MobilityProduct, double, false)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_MobilityProduct, single_double_sums, true)->Unit(benchmark::kMicrosecond);
 
 // The same with LAPACK (dgbtrf, then dgbtrs for one right-hand side), same storage.
 void BM_BandedLapack(benchmark::State& st, bool solve) {

@@ -39,16 +39,15 @@ Vec8 MaterialCurvatureGradient(const Vec3& kb, const Mat36& jacobian, const Mate
 // with the frames transported from the unperturbed tangents. Every term is linear in the directors
 // (u, u'), so Σ_a c_a ∂G_a/∂y is this Jacobian of the directors Σ_a c_a (u_a, u'_a): one evaluation
 // serves both curvatures.
-Mat8 MaterialCurvatureJacobian(const Vec3& e0, const Vec3& e1, const Vec3& kb,
-                               const Mat36& jacobian, const MaterialPair& u) {
+Mat8 MaterialCurvatureJacobian(const StencilCurvature& c, const MaterialPair& u) {
   const int edge_index[2] = {kEdge0, kEdge1};
   const int theta_index[2] = {kTheta0, kTheta1};
-  const Vec3 edges[2] = {e0, e1};
-  Mat6 jac_e = 0.5 * CalcCurvatureBinormalHessian(e0, e1, u.u[0] + u.u[1]);
+  const Vec3& kb = c.kb;
+  const Mat36& jacobian = c.jacobian;
+  Mat6 jac_e = 0.5 * CalcCurvatureBinormalHessian(c, u.u[0] + u.u[1]);
   for (int j = 0; j < 2; ++j) {
-    const double l = edges[j].norm();
-    const Vec3 t = edges[j] / l;
-    jac_e.middleCols<3>(3 * j) -= (0.5 / l) * (jacobian.transpose() * t) * u.u[j].transpose();
+    jac_e.middleCols<3>(3 * j) -=
+        (0.5 / c.length[j]) * (jacobian.transpose() * c.tangent[j]) * u.u[j].transpose();
   }
   Mat8 h = Mat8::Zero();
   for (int a = 0; a < 2; ++a)
@@ -81,40 +80,47 @@ Vec2 MaterialCurvatures(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Re
 double BendingEnergy(const BendingParams& p, const Vec3& x0, const Vec3& x1, const Vec3& x2,
                      const RefFrame& f0, const RefFrame& f1, double theta0, double theta1,
                      Vec11* gradient, Mat11* hessian) {
+  const StencilCurvature c = CalcStencilCurvature(x1 - x0, x2 - x1, gradient || hessian);
+  Vec8 g;
+  Mat8 h;
+  const double energy = BendingEdgeEnergy(p, c, f0, f1, theta0, theta1, gradient ? &g : nullptr,
+                                          hessian ? &h : nullptr);
+  if (gradient) *gradient = EdgeToStencilGradient(g);
+  if (hessian) *hessian = EdgeToStencilHessian(h);
+  return energy;
+}
+
+double BendingEdgeEnergy(const BendingParams& p, const StencilCurvature& c, const RefFrame& f0,
+                         const RefFrame& f1, double theta0, double theta1, Vec8* gradient,
+                         Mat8* hessian) {
   SR_ASSERT(p.stiffness >= 0.0, "bending: stiffness must be >= 0");
-  const Vec3 e0 = x1 - x0;
-  const Vec3 e1 = x2 - x1;
   Vec3 m1[2];
   Vec3 m2[2];
   MaterialFrame(f0, theta0, &m1[0], &m2[0]);
   MaterialFrame(f1, theta1, &m1[1], &m2[1]);
   // κ⁽¹⁾ = ½ (m2⁰ + m2¹)·κb,  κ⁽²⁾ = −½ (m1⁰ + m1¹)·κb  (paper eq. 3).
-  const Vec3 kb = CalcCurvatureBinormal(e0, e1);
+  const Vec3& kb = c.kb;
   const Vec2 excess =
       Vec2(0.5 * (m2[0] + m2[1]).dot(kb), -0.5 * (m1[0] + m1[1]).dot(kb)) - p.rest_curvature;
   const double energy = 0.5 * p.stiffness * excess.squaredNorm();
   if (!gradient && !hessian) return energy;
+  SR_ASSERT(c.has_derivatives, "bending: the gradient needs the curvature's derivatives");
   const MaterialPair pairs[2] = {{{m2[0], m2[1]}, {-m1[0], -m1[1]}},
                                  {{-m1[0], -m1[1]}, {-m2[0], -m2[1]}}};
   // E = ½ k Σ_a Δκ_a²:  ∇E = k Σ_a Δκ_a ∇κ_a,  ∂(∇E)/∂q = k Σ_a (∇κ_a ∇κ_aᵀ + Δκ_a ∂(∇κ_a)/∂q),
   // the last sum one Jacobian of the directors weighted by c_a = k Δκ_a (see above).
-  Mat36 jacobian;
-  CalcCurvatureBinormal(e0, e1, &jacobian);
-  const Vec8 grad[2] = {MaterialCurvatureGradient(kb, jacobian, pairs[0]),
-                        MaterialCurvatureGradient(kb, jacobian, pairs[1])};
-  const Vec8 g = p.stiffness * (excess[0] * grad[0] + excess[1] * grad[1]);
-  Mat8 h;
+  const Vec8 grad[2] = {MaterialCurvatureGradient(kb, c.jacobian, pairs[0]),
+                        MaterialCurvatureGradient(kb, c.jacobian, pairs[1])};
+  if (gradient) *gradient = p.stiffness * (excess[0] * grad[0] + excess[1] * grad[1]);
   if (hessian) {
     MaterialPair weighted;
     for (int j = 0; j < 2; ++j) {
       weighted.u[j] = p.stiffness * (excess[0] * pairs[0].u[j] + excess[1] * pairs[1].u[j]);
       weighted.du[j] = p.stiffness * (excess[0] * pairs[0].du[j] + excess[1] * pairs[1].du[j]);
     }
-    h = MaterialCurvatureJacobian(e0, e1, kb, jacobian, weighted);
-    for (int a = 0; a < 2; ++a) h.noalias() += p.stiffness * grad[a] * grad[a].transpose();
+    *hessian = MaterialCurvatureJacobian(c, weighted);
+    for (int a = 0; a < 2; ++a) hessian->noalias() += p.stiffness * grad[a] * grad[a].transpose();
   }
-  if (gradient) *gradient = EdgeToStencilGradient(g);
-  if (hessian) *hessian = EdgeToStencilHessian(h);
   return energy;
 }
 

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "stokesrods/common/types.h"
+#include "stokesrods/elastic/curvature.h"
 #include "stokesrods/rod/frames.h"
 
 namespace stokesrods {
@@ -33,5 +34,12 @@ Vec2 MaterialCurvatures(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Re
 double BendingEnergy(const BendingParams& p, const Vec3& x0, const Vec3& x1, const Vec3& x2,
                      const RefFrame& f0, const RefFrame& f1, double theta0, double theta1,
                      Vec11* gradient = nullptr, Mat11* hessian = nullptr);
+
+/// The same in the edge variables y (curvature.h), on the node's shared curvature `c` (made with
+/// derivatives when the gradient or its Jacobian is wanted): what the rod's assembly adds to the
+/// twisting's before mapping both to the stencil once.
+double BendingEdgeEnergy(const BendingParams& p, const StencilCurvature& c, const RefFrame& f0,
+                         const RefFrame& f1, double theta0, double theta1, Vec8* gradient,
+                         Mat8* hessian);
 
 }  // namespace stokesrods

@@ -36,9 +36,26 @@ struct EdgeDerivatives {
 /// If `jacobian` is given, it receives ∂κb/∂(e0, e1) (3 × 6) [1/m].
 Vec3 CalcCurvatureBinormal(const Vec3& e0, const Vec3& e1, Mat36* jacobian = nullptr);
 
+/// What the bending and twisting kernels of one node share: the edges, κb and, when made with
+/// derivatives, ∂κb/∂(e0, e1), the edges' lengths and tangents and the denominator
+/// D = |e0||e1| + e0·e1 of κb with its gradient (computed once per node, not once per kernel).
+struct StencilCurvature {
+  Vec3 e0, e1;
+  Vec3 kb;
+  bool has_derivatives = false;
+  Mat36 jacobian;        ///< ∂κb/∂(e0, e1) [1/m]
+  double length[2];      ///< |e0|, |e1|
+  Vec3 tangent[2];       ///< e0/|e0|, e1/|e1|
+  double denominator;    ///< D
+  Vec6 denominator_gradient;  ///< ∂D/∂(e0, e1) = (|e1| t0 + e1, |e0| t1 + e0)
+};
+StencilCurvature CalcStencilCurvature(const Vec3& e0, const Vec3& e1, bool with_derivatives);
+
 /// Σ_k w_k ∂²(κb)_k / ∂(e0, e1)²  (6 × 6, symmetric) [|w|/m²]: the Hessian of w·κb for a fixed
 /// vector w.
 Mat6 CalcCurvatureBinormalHessian(const Vec3& e0, const Vec3& e1, const Vec3& w);
+/// The same on a curvature made with derivatives.
+Mat6 CalcCurvatureBinormalHessian(const StencilCurvature& c, const Vec3& w);
 
 /// Gradient with respect to the stencil DOFs q (x0, θ0, x1, θ1, x2): Mᵀ g.
 Vec11 EdgeToStencilGradient(const Vec8& g);

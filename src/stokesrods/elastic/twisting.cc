@@ -23,23 +23,18 @@ namespace {
 // symmetric part of the Jacobian is the second derivative of m_ref with the frames transported from
 // the unperturbed tangents; the standard DER Hessian (Bergou et al. 2010; dismech) is that part.
 // The Jacobian only `with_jacobian` (else left at 0).
-EdgeDerivatives CalcReferenceTwistDerivatives(const Vec3& e0, const Vec3& e1, bool with_jacobian) {
-  Mat36 jacobian;
-  const Vec3 kb = CalcCurvatureBinormal(e0, e1, with_jacobian ? &jacobian : nullptr);
-  const double length[2] = {e0.norm(), e1.norm()};
-  const Vec3 tangent[2] = {e0 / length[0], e1 / length[1]};
+EdgeDerivatives CalcReferenceTwistDerivatives(const StencilCurvature& c, bool with_jacobian) {
   const int edge_index[2] = {kEdge0, kEdge1};
-
   EdgeDerivatives m;
   Mat8& jac = m.hessian;
   for (int i = 0; i < 2; ++i) {
     const int row = edge_index[i];
-    m.gradient.segment<3>(row) = kb / (2.0 * length[i]);
+    m.gradient.segment<3>(row) = c.kb / (2.0 * c.length[i]);
     if (!with_jacobian) continue;
     for (int j = 0; j < 2; ++j) {
-      jac.block<3, 3>(row, edge_index[j]) = jacobian.middleCols<3>(3 * j) / (2.0 * length[i]);
+      jac.block<3, 3>(row, edge_index[j]) = c.jacobian.middleCols<3>(3 * j) / (2.0 * c.length[i]);
     }
-    jac.block<3, 3>(row, row) -= kb * tangent[i].transpose() / (2.0 * length[i] * length[i]);
+    jac.block<3, 3>(row, row) -= c.kb * c.tangent[i].transpose() / (2.0 * c.length[i] * c.length[i]);
   }
   return m;
 }
@@ -49,20 +44,30 @@ EdgeDerivatives CalcReferenceTwistDerivatives(const Vec3& e0, const Vec3& e1, bo
 double TwistingEnergy(const TwistingParams& p, const Vec3& x0, const Vec3& x1, const Vec3& x2,
                       double theta0, double theta1, double reference_twist, Vec11* gradient,
                       Mat11* hessian) {
+  const StencilCurvature c = CalcStencilCurvature(x1 - x0, x2 - x1, gradient || hessian);
+  Vec8 g;
+  Mat8 h;
+  const double energy = TwistingEdgeEnergy(p, c, theta0, theta1, reference_twist,
+                                           gradient ? &g : nullptr, hessian ? &h : nullptr);
+  if (gradient) *gradient = EdgeToStencilGradient(g);
+  if (hessian) *hessian = EdgeToStencilHessian(h);
+  return energy;
+}
+
+double TwistingEdgeEnergy(const TwistingParams& p, const StencilCurvature& c, double theta0,
+                          double theta1, double reference_twist, Vec8* gradient, Mat8* hessian) {
   SR_ASSERT(p.stiffness >= 0.0, "twisting: stiffness must be >= 0");
   // τ = θ1 − θ0 + m_ref (paper eq. 4);  E = ½ k (τ − τ̄)²,
   // ∇E = k Δτ ∇τ,  ∂(∇E)/∂q = k (∇τ ∇τᵀ + Δτ ∂(∇m_ref)/∂q)  (θ enters τ linearly).
   const double excess = theta1 - theta0 + reference_twist - p.rest_twist;
   const double energy = 0.5 * p.stiffness * excess * excess;
   if (!gradient && !hessian) return energy;
-  EdgeDerivatives tau = CalcReferenceTwistDerivatives(x1 - x0, x2 - x1, hessian != nullptr);
+  SR_ASSERT(c.has_derivatives, "twisting: the gradient needs the curvature's derivatives");
+  EdgeDerivatives tau = CalcReferenceTwistDerivatives(c, hessian != nullptr);
   tau.gradient[kTheta0] = -1.0;
   tau.gradient[kTheta1] = 1.0;
-  if (gradient) *gradient = EdgeToStencilGradient(p.stiffness * excess * tau.gradient);
-  if (hessian) {
-    *hessian = EdgeToStencilHessian(
-        p.stiffness * (tau.gradient * tau.gradient.transpose() + excess * tau.hessian));
-  }
+  if (gradient) *gradient = p.stiffness * excess * tau.gradient;
+  if (hessian) *hessian = p.stiffness * (tau.gradient * tau.gradient.transpose() + excess * tau.hessian);
   return energy;
 }
 

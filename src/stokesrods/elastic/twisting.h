@@ -2,6 +2,7 @@
 #pragma once
 
 #include "stokesrods/common/types.h"
+#include "stokesrods/elastic/curvature.h"
 
 namespace stokesrods {
 
@@ -21,5 +22,10 @@ struct TwistingParams {
 double TwistingEnergy(const TwistingParams& p, const Vec3& x0, const Vec3& x1, const Vec3& x2,
                       double theta0, double theta1, double reference_twist,
                       Vec11* gradient = nullptr, Mat11* hessian = nullptr);
+
+/// The same in the edge variables y (curvature.h), on the node's shared curvature `c` (made with
+/// derivatives when the gradient or its Jacobian is wanted).
+double TwistingEdgeEnergy(const TwistingParams& p, const StencilCurvature& c, double theta0,
+                          double theta1, double reference_twist, Vec8* gradient, Mat8* hessian);
 
 }  // namespace stokesrods

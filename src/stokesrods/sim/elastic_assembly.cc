@@ -36,22 +36,23 @@ double AddElasticForces(const RodModel& rod, const VecX& q, const RodFrames& fra
     }
   }
 
-  Vec11 g11, t11;
-  Mat11 h11, th11;
-  for (int i = 1; i + 1 < n; ++i) {  // bending and twisting at node i: DOFs 4(i−1) … 4(i+1)+2
+  // Bending and twisting at node i share the curvature of the stencil (DOFs 4(i−1) … 4(i+1)+2)
+  // and are summed in the edge variables, then mapped to the stencil once.
+  Vec8 bend_g, twist_g;
+  Mat8 bend_h, twist_h;
+  for (int i = 1; i + 1 < n; ++i) {
     const double dl = rod.rest_voronoi_length(i);
     const double theta0 = q(o + TwistDof(i - 1)), theta1 = q(o + TwistDof(i));
+    const StencilCurvature c = CalcStencilCurvature(x(i) - x(i - 1), x(i + 1) - x(i), want_gradient);
     const BendingParams bp{rod.bending_stiffness / dl, rod.rest_curvature[i]};
-    energy += BendingEnergy(bp, x(i - 1), x(i), x(i + 1), frames.frames[i - 1], frames.frames[i],
-                            theta0, theta1, want_gradient ? &g11 : nullptr,
-                            hessian ? &h11 : nullptr);
+    energy += BendingEdgeEnergy(bp, c, frames.frames[i - 1], frames.frames[i], theta0, theta1,
+                                want_gradient ? &bend_g : nullptr, hessian ? &bend_h : nullptr);
     const TwistingParams tp{rod.twisting_stiffness / dl, rod.rest_twist(i)};
-    energy += TwistingEnergy(tp, x(i - 1), x(i), x(i + 1), theta0, theta1,
-                             frames.reference_twist(i), want_gradient ? &t11 : nullptr,
-                             hessian ? &th11 : nullptr);
+    energy += TwistingEdgeEnergy(tp, c, theta0, theta1, frames.reference_twist(i),
+                                 want_gradient ? &twist_g : nullptr, hessian ? &twist_h : nullptr);
     const int first = NodeDof(i - 1);  // the stencil is 11 consecutive DOFs
-    if (force) force->segment<11>(o + first) -= g11 + t11;
-    if (hessian) hessian->AddBlock(first, h11 + th11);
+    if (force) force->segment<11>(o + first) -= EdgeToStencilGradient(bend_g + twist_g);
+    if (hessian) hessian->AddBlock(first, EdgeToStencilHessian(bend_h + twist_h));
   }
   return energy;
 }
