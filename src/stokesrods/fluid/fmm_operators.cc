@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "stokesrods/common/assert.h"
+#include "stokesrods/fluid/point_stokeslet.h"
 #include "stokesrods/fluid/stokeslet_segment.h"
 
 namespace stokesrods {
@@ -63,24 +64,64 @@ std::unique_ptr<FmmOperators> MakeOperators(int order, double cutoff) {
     const Matrix3X parent_outer = (2.0 * outer).colwise() - 2.0 * o;  // in the child's units
     op->l2l[static_cast<size_t>(c)] = op->check_to_down * KernelMatrix(inner, parent_outer);
   }
-  std::vector<std::array<int, 3>> offsets;
-  for (int x = -3; x <= 3; ++x)
-    for (int y = -3; y <= 3; ++y)
-      for (int z = -3; z <= 3; ++z)
-        if (std::max({std::abs(x), std::abs(y), std::abs(z)}) >= 2 && M2lIndex(x, y, z) > 171)
-          offsets.push_back({x, y, z});
-#pragma omp parallel for schedule(dynamic, 1)
-  for (std::size_t i = 0; i < offsets.size(); ++i) {
-    const auto [x, y, z] = offsets[i];
-    const Matrix3X source = inner.colwise() + Vec3(x, y, z);  // the box at offset v = source − target
-    const auto index = static_cast<size_t>(M2lIndex(x, y, z));
-    op->m2l[index] = KernelMatrix(inner, source);
-    op->m2l_single[index] = op->m2l[index].cast<float>();
-  }
   return op;
 }
 
+/// The sources of AddM2l (S × 7, point_stokeslet.h): n equivalent Stokeslets per V-list entry at
+/// its box's surface r_in around the offset v, then zero-strength padding to whole blocks of
+/// kPointSumBlock (at the last source, ε² = 1).
+template <class Matrix>
+void FillM2lSources(const FmmOperators& op, const int* boxes, const int* offsets, int count,
+                    const MatX& up, Matrix* src) {
+  const int n = op.points;
+  const Eigen::Index used = static_cast<Eigen::Index>(count) * n;
+  const Eigen::Index rows = (used + kPointSumBlock - 1) / kPointSumBlock * kPointSumBlock;
+  src->resize(rows, 7);
+  using T = typename Matrix::Scalar;
+  for (int e = 0; e < count; ++e) {
+    const int o = offsets[e];
+    const Vec3 v(o / 49 - 3, o / 7 % 7 - 3, o % 7 - 3);
+    const double* g = up.col(boxes[e]).data();
+    for (int j = 0; j < n; ++j) {
+      const Eigen::Index row = static_cast<Eigen::Index>(e) * n + j;
+      const Vec3 y = kFmmInnerRadius * op.surface.col(j) + v;
+      for (int d = 0; d < 3; ++d) {
+        (*src)(row, d) = static_cast<T>(y[d]);
+        (*src)(row, 4 + d) = static_cast<T>(g[3 * j + d]);
+      }
+      (*src)(row, 3) = T(0);
+    }
+  }
+  for (Eigen::Index row = used; row < rows; ++row) {
+    src->row(row).template head<3>() = src->row(used - 1).template head<3>();
+    (*src)(row, 3) = T(1);
+    src->row(row).template tail<3>().setZero();
+  }
+}
+
 }  // namespace
+
+void AddM2l(const FmmOperators& op, const int* boxes, const int* offsets, int count,
+            const MatX& up, bool single, M2lScratch* scratch, double* check) {
+  if (count == 0) return;
+  const int n = op.points;
+  if (single) {
+    FillM2lSources(op, boxes, offsets, count, up, &scratch->sources_single);
+    const SourceColumnsF c = ColumnsF(scratch->sources_single);
+    const SourceRange all{0, static_cast<int>(scratch->sources_single.rows())};
+    for (int i = 0; i < n; ++i) {
+      const Eigen::Vector3f x = (kFmmInnerRadius * op.surface.col(i)).cast<float>();
+      AddPointSumBlocks(c, &all, 1, x.data(), check + 3 * i);
+    }
+    return;
+  }
+  FillM2lSources(op, boxes, offsets, count, up, &scratch->sources);
+  const SourceColumns c = Columns(scratch->sources);
+  for (int i = 0; i < n; ++i) {
+    const Vec3 x = kFmmInnerRadius * op.surface.col(i);
+    AddPointSum(c, 0, scratch->sources.rows(), x.data(), check + 3 * i);
+  }
+}
 
 const FmmOperators& GetFmmOperators(int order, double cutoff) {
   SR_ASSERT(order >= 2 && order <= 12, "FMM order out of range");

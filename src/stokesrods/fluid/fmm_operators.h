@@ -12,14 +12,17 @@
 // actual coordinates) and is computed once per order and process (GetFmmOperators).
 //
 // M2L, K_v = [S(x_i − y_j)] from the upward equivalent surface of the box at offset v (in box
-// widths, v ∈ {−3..3}³, |v|_∞ ≥ 2: the V list) to the downward check surface, is stored as the
-// dense 3n × 3n matrix for half of the offsets: the two surfaces coincide up to the shift, so
-// K_{−v} = K_vᵀ. (Compressing all K_v by one SVD basis, as Fong & Darve do, gave ranks within 10 %
-// of 3n at the tolerances of interest: the surfaces are already near minimal.)
+// widths, v ∈ {−3..3}³, |v|_∞ ≥ 2: the V list) to the downward check surface, is not stored: it
+// is a sum of n singular Stokeslets at n points, evaluated on the fly by the vectorized kernel of
+// the direct sum (AddM2l), which costs n² kernel evaluations per translation (3136 at p = 4,
+// 0.6 µs in single precision) where the stored dense 3n × 3n matrix cost 9n² multiply–adds read
+// from memory, batched by offset into BLAS products of a few columns (5.8 µs each on the
+// 100-helix lattice, half of it OpenBLAS packing K_v). (Compressing all K_v by one SVD basis, as
+// Fong & Darve do, gave ranks within 10 % of 3n at the tolerances of interest: the surfaces are
+// already near minimal.)
 #pragma once
 
 #include <array>
-#include <vector>
 
 #include "stokesrods/common/types.h"
 
@@ -34,28 +37,30 @@ struct FmmOperators {
   std::array<MatX, 8> m2m;       ///< child c's upward densities → the parent's
   std::array<MatX, 8> l2l;       ///< parent's downward densities → child c's
   MatX check_to_down;            ///< downward check (r_in) → downward equivalent (r_out)
-  std::array<MatX, 343> m2l;     ///< K_v for M2lIndex(v) > 171 (see M2lMatrix), else empty
-  std::array<Eigen::MatrixXf, 343> m2l_single;  ///< the same in single precision
 };
 
 inline constexpr double kFmmInnerRadius = 0.525;  ///< r_in in box widths
 inline constexpr double kFmmOuterRadius = 1.475;  ///< r_out in box widths
 
 /// The operators for p = order (2 ≤ p ≤ 12) and the relative cutoff of the pseudo-inverses;
-/// computed on first use (thread-safe; 0.1, 0.4, 1.5 s for p = 4, 5, 6), then cached for the
-/// process (K_v: 36, 110, 260 MB, and half that again in single precision).
+/// computed on first use (thread-safe), then cached for the process.
 const FmmOperators& GetFmmOperators(int order, double cutoff);
 
-/// Index of offset v in FmmOperators::m2l; index 342 − i is offset −v.
+/// Index of offset v in {−3..3}³ (the V lists' offsets; index 342 − i is offset −v).
 inline int M2lIndex(int vx, int vy, int vz) { return (vx + 3) * 49 + (vy + 3) * 7 + (vz + 3); }
 
-/// K_v for an M2L index: the stored matrix, or the transpose of the one of −v.
-inline bool M2lIsTransposed(int index) { return index < 171; }
-inline const MatX& M2lMatrix(const FmmOperators& op, int index) {
-  return op.m2l[static_cast<size_t>(M2lIsTransposed(index) ? 342 - index : index)];
-}
-inline const Eigen::MatrixXf& M2lMatrixSingle(const FmmOperators& op, int index) {
-  return op.m2l_single[static_cast<size_t>(M2lIsTransposed(index) ? 342 - index : index)];
-}
+/// The reusable buffer of AddM2l (the translations' sources, S × 7).
+struct M2lScratch {
+  MatX sources;
+  Eigen::MatrixXf sources_single;
+};
+
+/// M2L into one target box: check (3n, its downward check potentials) += Σ_e K_{v_e} up(:, box_e)
+/// over its V list (`count` entries: the source boxes' columns of `up`, 3n × boxes, and their
+/// offsets as M2lIndex), for boxes of width 1. The sum runs over the n equivalent Stokeslets of
+/// each source box at each check point (in single precision when `single`: positions in box
+/// widths, |v| ≤ 3.5, carry ~1e-7 of the distance). Deterministic: one sum, in list order.
+void AddM2l(const FmmOperators& op, const int* boxes, const int* offsets, int count,
+            const MatX& up, bool single, M2lScratch* scratch, double* check);
 
 }  // namespace stokesrods

@@ -3,7 +3,8 @@
 //
 // Apply: S2M (the leaf's sources, with their own regularized kernel, evaluated on the upward check
 // surface and fitted by upward equivalent densities), M2M up to level 2, M2L over the V lists of
-// every level (the dense K_v, all pairs of one offset in one BLAS product), L2L down, L2T (the
+// every level (each target box's V list summed as the source boxes' equivalent Stokeslets at its
+// check points: AddM2l, fmm_operators.h), L2L down, L2T (the
 // downward equivalent densities evaluated at the targets), and the near field (the 27 neighbouring
 // leaves) summed directly with the regularized kernel by the vectorized loop of the direct sum:
 // each leaf's sources padded to whole SIMD blocks by sources of zero strength, and a target's
@@ -11,16 +12,16 @@
 // Every box's work is done by one thread, in a fixed order: Apply is deterministic.
 //
 // DEPTH. The tree is cut at the depth of least estimated cost (FmmCost: kernel evaluations of the
-// near field, S2M and L2T, the translations per box and per M2L, and reading each K_v used), and
-// the sum is direct where that cost is not below S·T (unless forced, for tests). On the 100-helix
-// lattice this is depth 2 (boxes 0.1 m wide): 35 % of the pairs stay near, so one Apply costs
-// about 0.45 of the direct sum at p = 4 and 0.6 at p = 5, and the tree does not pay at p = 6
-// (bench_stokeslet_sum); deeper, each M2L (3n × 3n = 168² at p = 4) costs as much as summing
-// the two boxes' 30–70 points directly.
+// near field, S2M and L2T, n² per M2L, the dense translations per box), and the sum is direct
+// where that cost is not below S·T (unless forced, for tests). On the 100-helix lattice this is
+// depth 2 (boxes 0.095 m wide): 35 % of the pairs stay near, 1604 M2Ls; one Apply at p = 4
+// (7.9 ms, bench_stokeslet_sum) costs about half the single-precision direct sum (83 M pairs at
+// ≈ 0.18 ns); deeper, an M2L (n² = 3136 kernel evaluations at p = 4) costs more than summing the
+// two boxes' 30–70 points directly.
 //
 // PRECISION. From kSinglePrecisionTolerance (1e-4, stokeslet_sum.h) on, the near field, S2M and
-// the M2L products run in single precision (float SIMD lanes and sgemm; the fits, M2M, L2L and L2T
-// stay double): the measured errors at p = 4 are unchanged (tests/fluid/stokeslet_sum_test.cc).
+// M2L run in single precision (float SIMD lanes; the fits, M2M, L2L and L2T stay double): the
+// measured errors at p = 4 are unchanged (tests/fluid/stokeslet_sum_test.cc).
 //
 // REGULARIZATION. Far (V-list) pairs are approximated by Stokes flows, while S_ε is one only up
 // to O((ε/r)⁴): S_ε = S + (ε²/2)(I − 3 r̂r̂ᵀ)/r³ + ε⁴(−9/8 I + 15/8 r̂r̂ᵀ)/r⁵ + …, whose ε² term
@@ -48,10 +49,6 @@ namespace {
 
 constexpr double kEpsilonConstant = 2.0;  // c_ε
 
-extern "C" void sgemm_(const char* transa, const char* transb, const int* m, const int* n,
-                       const int* k, const float* alpha, const float* a, const int* lda,
-                       const float* b, const int* ldb, const float* beta, float* c,
-                       const int* ldc);
 extern "C" void dgemm_(const char* transa, const char* transb, const int* m, const int* n,
                        const int* k, const double* alpha, const double* a, const int* lda,
                        const double* b, const int* ldb, const double* beta, double* c,
@@ -71,19 +68,6 @@ void Gemm(const MatX& a, bool transpose_a, const MatX& b, double alpha, double b
   dgemm_(&ta, &tb, &m, &n, &k, &alpha, a.data(), &lda, b.data(), &ldb, &beta, c->data(), &ldc);
 }
 
-/// The same in single precision (the M2L of the single-precision sum).
-void Gemm(const Eigen::MatrixXf& a, bool transpose_a, const Eigen::MatrixXf& b, Eigen::MatrixXf* c) {
-  const int m = static_cast<int>(transpose_a ? a.cols() : a.rows());
-  const int n = static_cast<int>(b.cols()), k = static_cast<int>(b.rows());
-  c->resize(m, n);
-  if (m == 0 || n == 0) return;
-  const int lda = static_cast<int>(a.rows()), ldb = k, ldc = m;
-  const char ta = transpose_a ? 'T' : 'N', tb = 'N';
-  const float alpha = 1.0f, beta = 0.0f;
-  sgemm_(&ta, &tb, &m, &n, &k, &alpha, a.data(), &lda, b.data(), &ldb, &beta, c->data(), &ldc);
-}
-
-
 class FmmStokesletSum final : public StokesletSum {
  public:
   explicit FmmStokesletSum(const StokesletSumOptions& options)
@@ -102,7 +86,6 @@ class FmmStokesletSum final : public StokesletSum {
   void Downward() const;
   void Leaves(Matrix3X* w) const;
   void M2l(int level) const;
-  void GroupM2l();
   void PadSources(const Matrix3X& sources, const VecX& regularization);
 
   StokesletSumOptions options_;
@@ -124,11 +107,6 @@ class FmmStokesletSum final : public StokesletSum {
   Vec3 origin_ = Vec3::Zero();     // single precision: positions relative to it
   mutable Eigen::MatrixXf src_f_;  // src_ in single precision
   Eigen::Matrix3Xf x_f_;           // x_ in single precision
-  // M2L pairs (target box, source box) per level and offset, in the order of the target boxes, and
-  // their products' scratch.
-  std::vector<std::array<std::vector<std::pair<int, int>>, 343>> m2l_pairs_;
-  mutable std::vector<MatX> m2l_out_;  // per offset of a level
-  mutable std::vector<Eigen::MatrixXf> m2l_out_f_;
   mutable std::vector<MatX> up_, check_, down_;  // per level: 3n × boxes
   StokesletSumStats stats_;
 };
@@ -166,13 +144,10 @@ void FmmStokesletSum::Build(const Matrix3X& sources, const VecX& regularization,
   const int order = OrderFor(options_);
   if (order > 0 && pairs >= static_cast<double>(options_.direct_below_pairs)) {
     const double n = order * order * order - (order - 2) * (order - 2) * (order - 2);
-    // Costs in kernel evaluations (≈ 1.7 ns): a matrix entry ≈ 0.05 in the batched products
-    // (≈ 20 GFlop/s), and ≈ 0.6 to read and pack one K_v entry per level (memory bound).
+    // Costs in kernel evaluations (one pair of the near field): an M2L is n² of them (AddM2l),
+    // an entry of the dense per-box translations ≈ 0.05 (BLAS products over all boxes).
     const double entries = 9.0 * n * n;
-    const FmmCost cost{.per_point = n,
-                       .per_box = 0.05 * 4.0 * entries,
-                       .per_m2l = 0.05 * entries,
-                       .per_offset = 0.6 * entries};
+    const FmmCost cost{.per_point = n, .per_box = 0.05 * 4.0 * entries, .per_m2l = n * n};
     const double eps_max = regularization.size() > 0 ? regularization.cwiseAbs().maxCoeff() : 0.0;
     const double min_width = eps_max * std::pow(kEpsilonConstant / options_.tolerance, 0.25);
     tree_ = BuildFmmTree(sources, targets, min_width, cost, !options_.choose_by_cost);
@@ -212,7 +187,6 @@ void FmmStokesletSum::Build(const Matrix3X& sources, const VecX& regularization,
     down_[static_cast<size_t>(l)].resize(3 * op_->points, boxes);
     stats_.stored_values += 9 * op_->points * boxes;
   }
-  GroupM2l();
 }
 
 // The padded source layout (see the members) and the near field's ranges of slots, contiguous
@@ -260,18 +234,6 @@ void FmmStokesletSum::PadSources(const Matrix3X& sources, const VecX& regulariza
         near_ranges_.push_back(r);
     }
     near_range_start_.push_back(static_cast<int>(near_ranges_.size()));
-  }
-}
-
-void FmmStokesletSum::GroupM2l() {
-  m2l_pairs_.assign(static_cast<size_t>(tree_.depth) + 1, {});
-  for (int l = 2; l <= tree_.depth; ++l) {
-    const FmmList& v = tree_.v_lists[static_cast<size_t>(l)];
-    const int boxes = static_cast<int>(tree_.levels[static_cast<size_t>(l)].size());
-    auto& pairs = m2l_pairs_[static_cast<size_t>(l)];
-    for (int b = 0; b < boxes; ++b)
-      for (int e = v.start[static_cast<size_t>(b)]; e < v.start[static_cast<size_t>(b) + 1]; ++e)
-        pairs[static_cast<size_t>(v.offset[static_cast<size_t>(e)])].emplace_back(b, v.box[static_cast<size_t>(e)]);
   }
 }
 
@@ -353,51 +315,22 @@ void FmmStokesletSum::Downward() const {
   }
 }
 
-// The V-list translations of a level into the downward check potentials, batched by offset into
-// one matrix–matrix product each (the BLAS on one thread: see Gemm).
+// The V-list translations of a level into the downward check potentials (AddM2l), box by box:
+// each box's sum by one thread in list order, the same on any number of threads.
 void FmmStokesletSum::M2l(int level) const {
-  // The products of all offsets in parallel (OpenMP; the BLAS runs on one thread), each into its
-  // own output, then added to the check potentials in offset order: the same sums on any number
-  // of threads.
-  const auto& pairs = m2l_pairs_[static_cast<size_t>(level)];
+  const FmmList& v = tree_.v_lists[static_cast<size_t>(level)];
+  const auto& boxes = tree_.levels[static_cast<size_t>(level)];
   const MatX& up = up_[static_cast<size_t>(level)];
   MatX& check = check_[static_cast<size_t>(level)];
   check.setZero();
-  std::vector<int> offsets;
-  for (int o = 0; o < 343; ++o)
-    if (!pairs[static_cast<size_t>(o)].empty()) offsets.push_back(o);
-  const auto count = static_cast<int>(offsets.size());
-  m2l_out_.resize(static_cast<size_t>(count));
-  m2l_out_f_.resize(static_cast<size_t>(count));
 #pragma omp parallel
   {
-    MatX in;
-    Eigen::MatrixXf in_f;
-#pragma omp for schedule(dynamic, 1)
-    for (int i = 0; i < count; ++i) {
-      const int o = offsets[static_cast<size_t>(i)];
-      const auto& list = pairs[static_cast<size_t>(o)];
-      const auto m = static_cast<Eigen::Index>(list.size());
-      if (single_) {
-        in_f.resize(up.rows(), m);
-        for (Eigen::Index j = 0; j < m; ++j)
-          in_f.col(j) = up.col(list[static_cast<size_t>(j)].second).cast<float>();
-        Gemm(M2lMatrixSingle(*op_, o), M2lIsTransposed(o), in_f, &m2l_out_f_[static_cast<size_t>(i)]);
-      } else {
-        in.resize(up.rows(), m);
-        for (Eigen::Index j = 0; j < m; ++j) in.col(j) = up.col(list[static_cast<size_t>(j)].second);
-        Gemm(M2lMatrix(*op_, o), M2lIsTransposed(o), in, 1.0, 0.0, &m2l_out_[static_cast<size_t>(i)]);
-      }
-    }
-  }
-  for (int i = 0; i < count; ++i) {
-    const auto& list = pairs[static_cast<size_t>(offsets[static_cast<size_t>(i)])];
-    for (std::size_t j = 0; j < list.size(); ++j) {
-      const auto col = static_cast<Eigen::Index>(j);
-      if (single_)
-        check.col(list[j].first) += m2l_out_f_[static_cast<size_t>(i)].col(col).cast<double>();
-      else
-        check.col(list[j].first) += m2l_out_[static_cast<size_t>(i)].col(col);
+    M2lScratch scratch;
+#pragma omp for schedule(dynamic, 2)
+    for (std::size_t b = 0; b < boxes.size(); ++b) {
+      const int first = v.start[b], count = v.start[b + 1] - first;
+      AddM2l(*op_, v.box.data() + first, v.offset.data() + first, count, up, single_, &scratch,
+             check.col(static_cast<Eigen::Index>(b)).data());
     }
   }
 }

@@ -179,8 +179,11 @@ FmmTree BuildFmmTree(const Matrix3X& sources, const Matrix3X& targets, double mi
   const Vec3 hi = sources.rowwise().maxCoeff().cwiseMax(targets.rowwise().maxCoeff());
   const double extent = (hi - lo).maxCoeff();
   if (!(extent > 0.0) || !std::isfinite(extent)) return tree;
+  // The cube from the lowest corner of the points: along each axis they then span the fewest
+  // boxes of every level, ⌈extent_d / w⌉ (centred, a flat cloud such as the 100-helix lattice,
+  // 0.38 × 0.38 × 0.2 m, spilt into slivers of boxes above and below: twice the M2Ls).
   tree.width = extent * (1.0 + 1e-9);
-  tree.corner = 0.5 * (lo + hi) - Vec3::Constant(0.5 * tree.width);
+  tree.corner = lo - Vec3::Constant(0.5e-9 * extent);
   const auto src = SortByCode(sources, tree.corner, tree.width, &tree.source_order);
   const auto tgt = SortByCode(targets, tree.corner, tree.width, &tree.target_order);
   const double pairs = static_cast<double>(sources.cols()) * static_cast<double>(targets.cols());
@@ -196,9 +199,6 @@ FmmTree BuildFmmTree(const Matrix3X& sources, const Matrix3X& targets, double mi
     LinkParents(&tree.levels[static_cast<size_t>(level) - 1], &tree.levels.back());
     tree.v_lists.push_back(MakeVList(tree.levels[static_cast<size_t>(level) - 1], tree.levels.back(), level));
     m2l += static_cast<std::int64_t>(tree.v_lists.back().box.size());
-    std::vector<char> used(343, 0);
-    for (int o : tree.v_lists.back().offset) used[static_cast<size_t>(o)] = 1;
-    far_cost += cost.per_offset * static_cast<double>(std::count(used.begin(), used.end(), 1));
     far_cost += cost.per_box * static_cast<double>(tree.levels.back().size()) +
                 cost.per_m2l * static_cast<double>(tree.v_lists.back().box.size());
     std::int64_t near = 0;

@@ -34,8 +34,7 @@ struct FmmList {
 struct FmmCost {
   double per_point = 0.0;  ///< S2M and L2T: a source or target against a surface
   double per_box = 0.0;    ///< the dense translations of one box (M2M, L2L, check → equivalent)
-  double per_m2l = 0.0;    ///< one M2L (its share of a batched matrix–matrix product)
-  double per_offset = 0.0; ///< one M2L matrix K_v used at a level (read from memory once)
+  double per_m2l = 0.0;    ///< one M2L (a V-list pair of boxes)
 };
 
 struct FmmTree {
