@@ -95,6 +95,9 @@ class DenseMobility final : public MobilityOperator {
     if (double_stale_) matrix_ = single_.cast<double>(), double_stale_ = false;
     return &matrix_;
   }
+  const Eigen::MatrixXf* single_matrix() const override {
+    return single_current_ ? &single_ : nullptr;
+  }
 
  private:
   FluidParams params_;

@@ -103,6 +103,9 @@ class MobilityOperator {
   virtual MatX SelfBlock(int rod) const = 0;
   /// The assembled 𝕄 when the operator holds one, else nullptr.
   virtual const MatX* matrix() const { return nullptr; }
+  /// 𝕄 in single precision when the last Update made it so (the dense 𝕄 extrapolated by its
+  /// reuse, fluid/mobility_reuse.h), else nullptr: for what reads it in single precision anyway.
+  virtual const Eigen::MatrixXf* single_matrix() const { return nullptr; }
   /// Forgets what the operator keeps from earlier Updates (a restart point: the next Update
   /// then depends on its geometry alone).
   virtual void ForgetHistory() {}

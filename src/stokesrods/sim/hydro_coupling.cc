@@ -164,6 +164,14 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
       if (!capacitance_blocks_.Build(model, h, blocks, MakeHydroRods(model, positions_), bodies_,
                                      borders_, true))
         return have_preconditioner_ = false;
+    } else if (krylov_ && !borders_ && mobility_->single_matrix() != nullptr) {
+      // The reused 𝕄 is single precision already: C for the float LU in one pass.
+      Eigen::MatrixXf capacitance = static_cast<float>(h) * *mobility_->single_matrix();
+      for (std::size_t r = 0; r < model.rods.size(); ++r) {
+        const int first = 3 * model.rods[r].node_offset, n = static_cast<int>(sx_blocks_[r].rows());
+        capacitance.block(first, first, n, n) += sx_blocks_[r].cast<float>();
+      }
+      if (!capacitance_lu_float_.Compute(std::move(capacitance))) return have_preconditioner_ = false;
     } else {
       MatX capacitance = h * *mobility_->matrix();
       for (std::size_t r = 0; r < model.rods.size(); ++r) {
