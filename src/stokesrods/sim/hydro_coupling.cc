@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "stokesrods/common/assert.h"
 #include "stokesrods/fluid/mobility_sources.h"
@@ -80,7 +81,14 @@ HydroSolveReport HydroCoupling::Prepare(const Model& model, const VecX& q_start,
   VecX u;
   GatherNodeVelocities(model, v_start, VecX::Zero(v_start.size()), 1.0, &u);
   if (const MatX* m = mobility_->matrix()) {
-    explicit_force_ = -m->partialPivLu().solve(u);
+    // The LU of 𝕄 at every step, by LAPACK (solver/dense_lu.h; Eigen's kernels on this build's
+    // baseline x86-64 took 80 % of an explicit step). An exactly singular 𝕄 leaves the drag not a
+    // number, which the Newton test then reports.
+    explicit_force_ = -u;
+    if (explicit_lu_.Compute(*m))
+      explicit_lu_.Solve(&explicit_force_);
+    else
+      explicit_force_.setConstant(std::numeric_limits<double>::quiet_NaN());
     return report;
   }
   // The self-mobility blocks change little from step to step: rebuilt every 20 steps.

@@ -133,6 +133,7 @@ class HydroCoupling {
   bool wants_refresh_ = false;
   long krylov_total_ = 0;
   HydroSolveReport worst_solve_;
+  DenseLu<double> explicit_lu_;  ///< the explicit coupling's LU of a dense 𝕄 (every step)
   // The explicit coupling's solve with a matrix-free 𝕄: block LU of the self-mobilities.
   std::unique_ptr<SelfMobilityPreconditioner> explicit_blocks_;
   int explicit_blocks_age_ = 0;
