@@ -15,6 +15,7 @@
 #include "stokesrods/sim/hydro_coupling.h"
 #include "stokesrods/sim/integrator.h"
 #include "stokesrods/solver/blas.h"
+#include "stokesrods/solver/dense_lu.h"
 
 extern "C" {  // LAPACK's banded LU, the reference BandedMatrix replaced (OpenBLAS)
 void dgbtrf_(const int* m, const int* n, const int* kl, const int* ku, double* ab,
@@ -150,6 +151,23 @@ void BM_MobilityProduct(benchmark::State& st, bool single) {
 }
 BENCHMARK_CAPTURE(BM_MobilityProduct, double, false)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_MobilityProduct, single_double_sums, true)->Unit(benchmark::kMicrosecond);
+
+// The preconditioner's solve of one vector with the float LU of Fig. 1's C (3M = 390): getrs
+// against the blocked substitution of solver/lu_solve_avx512.cc.
+void BM_FloatLuSolve(benchmark::State& st, bool lapack) {
+  const int n = 390;
+  const Eigen::MatrixXf a = Eigen::MatrixXf::Random(n, n) + n * Eigen::MatrixXf::Identity(n, n);
+  DenseLu<float> lu;
+  lu.Compute(a);
+  const Eigen::VectorXf b = Eigen::VectorXf::Random(n);
+  for (auto _ : st) {
+    Eigen::VectorXf x = b;
+    lu.Solve(&x, lapack);
+    benchmark::DoNotOptimize(x.data());
+  }
+}
+BENCHMARK_CAPTURE(BM_FloatLuSolve, getrs, true)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_FloatLuSolve, blocked, false)->Unit(benchmark::kMicrosecond);
 
 // The same with LAPACK (dgbtrf, then dgbtrs for one right-hand side), same storage.
 void BM_BandedLapack(benchmark::State& st, bool solve) {

@@ -1,5 +1,6 @@
 #include "stokesrods/solver/dense_lu.h"
 
+#include <type_traits>
 #include <utility>
 
 #include "stokesrods/common/assert.h"
@@ -42,11 +43,19 @@ bool DenseLu<Scalar>::Compute(Matrix a) {
   return info == 0;
 }
 
+// lu_solve_avx512.cc: one right-hand side on AVX-512 (blocked substitution), for single precision.
+void LuSolveAvx512(int n, const float* lu, const int* pivots, float* x);
+bool HasLuSolveAvx512();
+
 template <typename Scalar>
-void DenseLu<Scalar>::Solve(Vector* b) const {
+void DenseLu<Scalar>::Solve(Vector* b, bool use_lapack) const {
   SR_ASSERT(b->size() == lu_.rows(), "DenseLu: right-hand side of the wrong size");
   const int n = static_cast<int>(lu_.rows());
   if (n == 0) return;
+  if constexpr (std::is_same_v<Scalar, float>) {
+    if (!use_lapack && HasLuSolveAvx512())
+      return LuSolveAvx512(n, lu_.data(), pivots_.data(), b->data());
+  }
   int info = 0;
   Getrs(n, lu_.data(), pivots_.data(), b->data(), &info);
   SR_ASSERT(info == 0, "DenseLu: bad argument to getrs");
