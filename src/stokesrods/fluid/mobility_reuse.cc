@@ -6,10 +6,10 @@
 namespace stokesrods {
 namespace {
 
-// The extrapolation's two passes over the matrices, as plain loops vectorized for the CPU at hand
-// (the build targets baseline x86-64, where Eigen's expressions use SSE2 only; GCC 12 at -O2
-// vectorizes only loops marked `omp simd`). Each runs once per step or per assembly over all
-// 9M² entries and was 10 % of Fig. 1's step as Eigen expressions.
+// The reuse's passes over the matrices, as plain loops vectorized for the CPU at hand (the build
+// targets baseline x86-64, where Eigen's expressions use SSE2 only; GCC 12 at -O2 vectorizes only
+// loops marked `omp simd`): one per step (forming the extrapolation) or per assembly (taking it
+// into the history), over all 9M² entries; as Eigen expressions they were 10 % of Fig. 1's step.
 
 // out = base + s · slope (n entries).
 __attribute__((target_clones("avx512f", "avx2", "default")))
@@ -18,15 +18,28 @@ void Extrapolate(Eigen::Index n, const float* base, float s, const float* slope,
   for (Eigen::Index i = 0; i < n; ++i) out[i] = base[i] + s * slope[i];
 }
 
-// Σ (base + s · slope − exact)², in double.
+// An assembled 𝕄 (`exact`, double) taken into the history in one pass: returns the squared miss
+// Σ (base + s · slope − exact)² of the extrapolation it replaces and Σ exact² in `norm2` (when
+// `measure`), then sets slope = exact − last (when `have_last`; rounded once), base = exact
+// (rounded), last = exact.
 __attribute__((target_clones("avx512f", "avx2", "default")))
-double SquaredMiss(Eigen::Index n, const float* base, double s, const float* slope,
-                   const double* exact) {
-  double sum = 0.0;
-#pragma omp simd reduction(+ : sum)
+double TakeAssembly(Eigen::Index n, const double* exact, double s, bool measure, bool have_last,
+                    float* base, float* slope, double* last, double* norm2) {
+  double sum = 0.0, exact2 = 0.0;
+  if (measure) {
+#pragma omp simd reduction(+ : sum, exact2)
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double d = static_cast<double>(base[i]) + s * static_cast<double>(slope[i]) - exact[i];
+      sum += d * d;
+      exact2 += exact[i] * exact[i];
+    }
+  }
+  *norm2 = exact2;
+#pragma omp simd
   for (Eigen::Index i = 0; i < n; ++i) {
-    const double d = static_cast<double>(base[i]) + s * static_cast<double>(slope[i]) - exact[i];
-    sum += d * d;
+    if (have_last) slope[i] = static_cast<float>(exact[i] - last[i]);
+    base[i] = static_cast<float>(exact[i]);
+    last[i] = exact[i];
   }
   return sum;
 }
@@ -52,25 +65,29 @@ bool MobilityReuse::Update(const VecX& x, const std::function<void(MatX*)>& asse
   if (!same_size) history_ = 0;
   assemble(assembled);
   ++stats_.assemblies;
-  if (history_ == 2) {
-    // What the extrapolation gives here, since_ + 1 updates from base_ (one more than the
-    // farthest used since base_, so it bounds them), rounding included.
-    const double s = Projection(x);
-    const double error =
-        std::sqrt(SquaredMiss(base_.size(), base_.data(), s, slope_.data(), assembled->data())) /
-        std::max(assembled->norm(), 1e-300);
+  const Eigen::Index rows = assembled->rows(), cols = assembled->cols();
+  const bool measure = history_ == 2;
+  if (history_ == 0) {
+    base_.resize(rows, cols);
+    slope_.resize(rows, cols);
+    last_assembled_.resize(rows, cols);
+  }
+  // What the extrapolation gives here, since_ + 1 updates from base_ (one more than the farthest
+  // used since base_, so it bounds them), rounding included.
+  const double s = measure ? Projection(x) : 0.0;
+  double norm2 = 0.0;
+  const double miss = std::sqrt(TakeAssembly(assembled->size(), assembled->data(), s, measure,
+                                             history_ >= 1, base_.data(), slope_.data(),
+                                             last_assembled_.data(), &norm2));
+  if (measure) {
+    const double error = miss / std::max(std::sqrt(norm2), 1e-300);
     if (since_ > 0) stats_.largest_error = std::max(stats_.largest_error, error);
     const int used = since_ + 1;
     const double grow = error > 0.0 ? 0.9 * std::sqrt(tolerance_ / error) : 2.0;
     interval_ = std::clamp(static_cast<int>(std::floor(used * std::min(grow, 2.0))), 1,
                            kMaxInterval);
   }
-  if (history_ >= 1) {
-    slope_ = (*assembled - last_assembled_).cast<float>();
-    step_x_ = x - base_x_;
-  }
-  last_assembled_ = *assembled;
-  base_ = assembled->cast<float>();
+  if (history_ >= 1) step_x_ = x - base_x_;
   base_x_ = x;
   history_ = std::min(history_ + 1, 2);
   since_ = 0;
