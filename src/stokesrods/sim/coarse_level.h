@@ -31,8 +31,11 @@ struct CoarseRod {
 
 class CoarseLevel {
  public:
-  /// Chunks of consecutive nodes per rod (fewer when a rod has fewer nodes).
-  static constexpr int kChunksPerRod = 4;
+  /// Chunks of consecutive nodes per rod (fewer when a rod has fewer nodes). Measured on the
+  /// bench's lattices (one thread, 20 steps after 60, GMRES products per step at 4 / 6 / 8 / 16):
+  /// lattice100 6.4 / 5.85 / 5.05 / 4.0, lattice50 6.0 / 5.0 / 5.0 / 4.0; 8 is the fastest
+  /// (16: E's LU, (48 R)³ flops at every rebuild, and its solves cost more than they save).
+  static constexpr int kChunksPerRod = 8;
 
   /// blocks[k] = D_k (3N_k × 3N_k), scale = h / (8πμ). False when E is singular (a zero pivot).
   bool Build(const std::vector<CoarseRod>& rods, const std::vector<MatX>& blocks, double scale);
