@@ -10,11 +10,9 @@
 #include <Eigen/LU>
 
 #include "stokesrods/solver/blas.h"
+#include "stokesrods/solver/lu_solve_avx512.h"
 
 namespace stokesrods {
-
-bool HasLuSolveAvx512();  // solver/lu_solve_avx512.cc
-
 namespace {
 
 template <typename Scalar>

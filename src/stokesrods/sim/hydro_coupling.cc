@@ -48,6 +48,15 @@ std::vector<HydroRod> MakeHydroRods(const Model& model, const std::vector<Matrix
   return rods;
 }
 
+// C += S X on each rod's diagonal block (X's rows at the rod's nodes), in C's precision.
+template <typename Matrix>
+void AddSchurBlocks(const Model& model, const std::vector<MatX>& sx_blocks, Matrix* capacitance) {
+  for (std::size_t r = 0; r < model.rods.size(); ++r) {
+    const int first = 3 * model.rods[r].node_offset, n = static_cast<int>(sx_blocks[r].rows());
+    capacitance->block(first, first, n, n) += sx_blocks[r].cast<typename Matrix::Scalar>();
+  }
+}
+
 constexpr int kFullLuBelow = 3000;
 // Steps a Krylov preconditioner is kept at most (it is rebuilt sooner when GMRES slows down).
 constexpr int kPreconditionerMaxAge = 20;
@@ -175,17 +184,11 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
     } else if (krylov_ && !borders_ && mobility_->single_matrix() != nullptr) {
       // The reused 𝕄 is single precision already: C for the float LU in one pass.
       Eigen::MatrixXf capacitance = static_cast<float>(h) * *mobility_->single_matrix();
-      for (std::size_t r = 0; r < model.rods.size(); ++r) {
-        const int first = 3 * model.rods[r].node_offset, n = static_cast<int>(sx_blocks_[r].rows());
-        capacitance.block(first, first, n, n) += sx_blocks_[r].cast<float>();
-      }
+      AddSchurBlocks(model, sx_blocks_, &capacitance);
       if (!capacitance_lu_float_.Compute(std::move(capacitance))) return have_preconditioner_ = false;
     } else {
       MatX capacitance = h * *mobility_->matrix();
-      for (std::size_t r = 0; r < model.rods.size(); ++r) {
-        const int first = 3 * model.rods[r].node_offset, n = static_cast<int>(sx_blocks_[r].rows());
-        capacitance.block(first, first, n, n) += sx_blocks_[r];
-      }
+      AddSchurBlocks(model, sx_blocks_, &capacitance);
       if (borders_) AddClampBordersToCapacitance(model, h, *borders_, &capacitance);
       if (krylov_) {
         if (!capacitance_lu_float_.Compute(capacitance.cast<float>()))

@@ -135,8 +135,9 @@ inline __attribute__((always_inline)) void SolveBand(int n, int kd_runtime, cons
 // long vector operation across them.
 template <int KD>
 inline __attribute__((always_inline)) void SolveBandRows(int n, int kd_runtime, const double* ab,
-                                                         const int* pivots, int num_rhs,
-                                                         double* x) {
+                                                         const int* pivots,
+                                                         const double* inverse_diagonal,
+                                                         int num_rhs, double* x) {
   const int kd = KD > 0 ? KD : kd_runtime, kv = 2 * kd, ldab = 3 * kd + 1;
   auto row = [&](int i) { return x + static_cast<std::ptrdiff_t>(i) * num_rhs; };
   auto subtract = [num_rhs](double a, const double* from, double* to) {
@@ -152,8 +153,7 @@ inline __attribute__((always_inline)) void SolveBandRows(int n, int kd_runtime, 
   }
   for (int j = n - 1; j >= 0; --j) {
     const double* column = ab + static_cast<std::ptrdiff_t>(j) * ldab;
-    const double inverse = 1.0 / column[kv];
-    for (int k = 0; k < num_rhs; ++k) row(j)[k] *= inverse;
+    for (int k = 0; k < num_rhs; ++k) row(j)[k] *= inverse_diagonal[j];
     for (int i = std::max(0, j - kv); i < j; ++i)
       if (column[kv + i - j] != 0.0) subtract(column[kv + i - j], row(j), row(i));
   }
@@ -177,9 +177,11 @@ void Solve(int n, int kd, const double* ab, const int* pivots, const double* inv
 }
 
 __attribute__((target_clones("avx512f", "avx2", "default")))
-void SolveRows(int n, int kd, const double* ab, const int* pivots, int num_rhs, double* x) {
-  if (kd == kRodHalfBandwidth) return SolveBandRows<kRodHalfBandwidth>(n, kd, ab, pivots, num_rhs, x);
-  SolveBandRows<0>(n, kd, ab, pivots, num_rhs, x);
+void SolveRows(int n, int kd, const double* ab, const int* pivots, const double* inverse_diagonal,
+               int num_rhs, double* x) {
+  if (kd == kRodHalfBandwidth)
+    return SolveBandRows<kRodHalfBandwidth>(n, kd, ab, pivots, inverse_diagonal, num_rhs, x);
+  SolveBandRows<0>(n, kd, ab, pivots, inverse_diagonal, num_rhs, x);
 }
 
 }  // namespace
@@ -213,7 +215,7 @@ void BandedMatrix::SolveManyRows(double* b, int num_rhs) const {
   using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   Eigen::Map<MatX> columns(b, n_, num_rhs);
   RowMajor x = columns;
-  SolveRows(n_, kd_, ab_.data(), pivots_.data(), num_rhs, x.data());
+  SolveRows(n_, kd_, ab_.data(), pivots_.data(), inverse_diagonal_.data(), num_rhs, x.data());
   columns = x;
 }
 

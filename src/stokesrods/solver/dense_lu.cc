@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "stokesrods/common/assert.h"
+#include "stokesrods/solver/lu_solve_avx512.h"
 
 extern "C" {
 void sgetrf_(const int* m, const int* n, float* a, const int* lda, int* ipiv, int* info);
@@ -42,10 +43,6 @@ bool DenseLu<Scalar>::Compute(Matrix a) {
   SR_ASSERT(info >= 0, "DenseLu: bad argument to getrf");
   return info == 0;
 }
-
-// lu_solve_avx512.cc: one right-hand side on AVX-512 (blocked substitution), for single precision.
-void LuSolveAvx512(int n, const float* lu, const int* pivots, float* x);
-bool HasLuSolveAvx512();
 
 template <typename Scalar>
 void DenseLu<Scalar>::Solve(Vector* b, bool use_lapack) const {

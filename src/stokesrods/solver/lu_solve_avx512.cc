@@ -11,7 +11,9 @@
 #include <algorithm>
 #include <utility>
 
-#include "stokesrods/solver/dense_lu.h"
+#include <Eigen/Core>
+
+#include "stokesrods/solver/lu_solve_avx512.h"
 
 namespace stokesrods {
 
