@@ -1,5 +1,6 @@
 #include "stokesrods/fluid/lsbt.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "stokesrods/common/assert.h"
@@ -26,7 +27,10 @@ LsbtDiscretizationCheck CheckLsbtDiscretization(const Matrix3X& x, double radius
     }
   }
   check.fits = check.edges_outside == 0;
-  check.suggested_nodes = 1 + static_cast<int>(std::lround(arc_length / check.target_edge_length));
+  // At most 1e9 (a radius so small that more nodes would be needed is refused all the same; the
+  // count stays an int: the fuzzer found 7e8 overflowing 4 N in build_model.cc).
+  check.suggested_nodes =
+      1 + static_cast<int>(std::min(1e9, std::round(arc_length / check.target_edge_length)));
   return check;
 }
 

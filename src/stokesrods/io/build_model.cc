@@ -46,7 +46,7 @@ int FittingLsbtNodes(RodConfig rc, int estimate, int allowed) {
   };
   const int fewest = rc.shape == "helix" ? 5 : 3;
   int lo = fewest;
-  int hi = std::min(1000000, std::max(64, 4 * estimate));
+  int hi = static_cast<int>(std::min<long long>(1000000, std::max<long long>(64, 4LL * estimate)));
   if (last_edge(hi) > target) return 0;
   while (lo < hi) {
     const int mid = lo + (hi - lo) / 2;
