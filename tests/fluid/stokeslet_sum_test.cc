@@ -118,6 +118,20 @@ TEST(StokesletSumTest, HelixLatticeMeetsTheTolerance) {
   }
 }
 
+// By cost, the root cube of 50 helices (6400 sources × 3250 targets) is wider than the points
+// (fmm_tree.cc: extent × 2^(k/4)): its leaves leave 5.7 M near pairs where the root of side
+// `extent` left 12.0 M (and 8.8 M far), and the sum still meets the tolerance.
+TEST(StokesletSumTest, ChoosesTheRootWidthByCostAndMeetsTheTolerance) {
+  std::mt19937 rng(10);
+  const Cloud c = HelixLattice(5, 10);
+  const Result r = Compare(c, {.tolerance = 1e-4, .direct_below_pairs = 0}, &rng);
+  std::printf("50 helices by cost: error %.2e, near pairs %lld, far pairs %lld\n", r.error,
+              static_cast<long long>(r.stats.near_pairs), static_cast<long long>(r.stats.far_pairs));
+  EXPECT_LT(r.error, 1e-4);
+  EXPECT_GT(r.error, 1e-7);
+  EXPECT_LT(r.stats.near_pairs, 8'000'000);
+}
+
 TEST(StokesletSumTest, BelowTheReachOfTheExpansionsSumsDirectly) {
   std::mt19937 rng(8);
   const Cloud c = HelixLattice(2, 5);

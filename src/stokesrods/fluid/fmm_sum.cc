@@ -13,11 +13,12 @@
 //
 // DEPTH. The tree is cut at the depth of least estimated cost (FmmCost: kernel evaluations of the
 // near field, S2M and L2T, n² per M2L, the dense translations per box), and the sum is direct
-// where that cost is not below S·T (unless forced, for tests). On the 100-helix lattice this is
-// depth 2 (boxes 0.095 m wide): 35 % of the pairs stay near, 1604 M2Ls; one Apply at p = 4
-// (7.9 ms, bench_stokeslet_sum) costs about half the single-precision direct sum (83 M pairs at
-// ≈ 0.18 ns); deeper, an M2L (n² = 3136 kernel evaluations at p = 4) costs more than summing the
-// two boxes' 30–70 points directly.
+// where that cost is not below S·T (unless forced, for tests). Deeper, an M2L (n² = 3136 kernel
+// evaluations at p = 4) costs more than summing two boxes of 30–70 points directly, so the leaf
+// width is chosen finer than a factor 2: the root cube's side is extent × 2^(k/4), k = 0 … 3, by
+// the same cost (fmm_tree.cc). On the 100-helix lattice: the root 1.68 × extent at depth 3
+// (leaves 0.080 m wide), 23 % of the pairs near and 2914 M2Ls, where the root of side extent gave
+// depth 2 (leaves 0.095 m), 35 % near and 1604 M2Ls.
 //
 // PRECISION. From kSinglePrecisionTolerance (1e-4, stokeslet_sum.h) on, the near field, S2M and
 // M2L run in single precision (float SIMD lanes; the fits, M2M, L2L and L2T stay double): the
