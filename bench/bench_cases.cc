@@ -2,11 +2,13 @@
 // A plain program (no Google Benchmark) so that each case runs in its own process and its peak
 // memory is its own; bench/run_table.py runs the cases and prints the table (bench/README.md).
 //
-//   bench_cases CASE [--steps K] [--warmup W] [--set dotted.key=value]...
+//   bench_cases CASE [--steps K] [--warmup W] [--set dotted.key=value]... [--step-times FILE]
 //   bench_cases CASE --print-config     (the case as a configuration file, for stokesrods run)
 //
 // Builds the case's configuration as TOML text, applies the --set overrides (SPEC syntax), runs W
 // untimed steps from rest, then K steps each timed with steady_clock, and prints one line of JSON.
+// --step-times writes one CSV line per timed step (the step's number, wall ms, Newton iterations,
+// GMRES products, whether 𝕄 was assembled): where periodic work falls (restart points, rebuilds).
 // Exit codes: 0 success, 2 invalid input (unknown case, bad option, bad --set), 3 a step failed
 // or memory ran out. The JSON line is printed in every case but a bad command line.
 #include <sys/resource.h>
@@ -135,6 +137,7 @@ struct Options {
   int warmup = kDefaultWarmup;
   std::vector<std::string> overrides;
   bool print_config = false;  ///< print the case's TOML (before overrides) and exit
+  std::string step_times;     ///< CSV file of the per-step times, if given
 };
 
 void PrintUsage(std::FILE* to) {
@@ -142,6 +145,7 @@ void PrintUsage(std::FILE* to) {
   for (const std::string& n : CaseNames()) names += " " + n;
   fmt::print(to,
              "usage: bench_cases CASE [--steps K] [--warmup W] [--set dotted.key=value]...\n"
+             "                  [--step-times FILE]\n"
              "       bench_cases CASE --print-config\n"
              "cases:{}\n",
              names);
@@ -181,6 +185,13 @@ std::optional<Options> ParseArgs(int argc, char** argv) {
       o.overrides.push_back(*v);
     } else if (arg.rfind("--set=", 0) == 0) {
       o.overrides.push_back(arg.substr(6));
+    } else if (arg == "--step-times") {
+      const std::optional<std::string> v = value();
+      if (!v || v->empty()) {
+        fmt::print(stderr, "bench_cases: --step-times needs a file name\n");
+        return std::nullopt;
+      }
+      o.step_times = *v;
     } else if (arg == "--print-config") {
       o.print_config = true;
     } else if (arg == "-h" || arg == "--help") {
@@ -266,8 +277,19 @@ int RunCase(const Options& options, const CaseSpec& spec, nlohmann::ordered_json
   long newton = 0, krylov = 0;
   const MobilityReuseStats reuse_start =
       ws.nonlocal_fluid ? ws.hydro.mobility().reuse_stats() : MobilityReuseStats{};
+  std::FILE* step_times = nullptr;
+  if (!options.step_times.empty()) {
+    step_times = std::fopen(options.step_times.c_str(), "w");
+    if (!step_times)
+      throw ConfigError(options.step_times, "--step-times", "cannot be written");
+    fmt::print(step_times, "step,ms,newton,krylov,assembled\n");
+  }
+  auto assemblies = [&]() {
+    return ws.nonlocal_fluid ? ws.hydro.mobility().reuse_stats().assemblies : 0L;
+  };
   const double cpu_start = ProcessCpuMs();
   for (int k = 0; k < options.steps && failure.empty(); ++k) {
+    const long assemblies_before = assemblies();
     const auto start = std::chrono::steady_clock::now();
     const StepReport r = step();
     const auto stop = std::chrono::steady_clock::now();
@@ -276,11 +298,15 @@ int RunCase(const Options& options, const CaseSpec& spec, nlohmann::ordered_json
       break;
     }
     ms.push_back(std::chrono::duration<double, std::milli>(stop - start).count());
+    if (step_times)
+      fmt::print(step_times, "{},{:.4f},{},{},{}\n", state.step, ms.back(), r.newton_iterations,
+                 r.krylov_iterations, assemblies() - assemblies_before);
     PrintProgress("step", k + 1, options.steps, start);
     newton += r.newton_iterations;
     krylov += r.krylov_iterations;
   }
   const double cpu_ms = ProcessCpuMs() - cpu_start;
+  if (step_times) std::fclose(step_times);
   const double n = static_cast<double>(ms.size());
   const double mean = ms.empty() ? std::nan("") : std::accumulate(ms.begin(), ms.end(), 0.0) / n;
   j["steps"] = ms.size();

@@ -128,5 +128,60 @@ TEST(MobilityReuse, ForgettingRestartsFromTwoAssemblies) {
   EXPECT_LT(o.worst_error, 1.5e-4);
 }
 
+// A restart point keeps the reuse (AtRestartPoint), and a fresh operator given its history
+// (reuse_history, as a checkpoint keeps it) assembles the history's matrices again and then
+// gives the same 𝕄 as the uninterrupted operator at every later update, bit for bit, assembling
+// where it assembles: the exact resume of a run (io/checkpoint.h) rests on this.
+TEST(MobilityReuse, RestoredHistoryContinuesBitForBit) {
+  FluidParams params;
+  MobilityOptions options;
+  options.reuse_tolerance = 1e-4;
+  const auto run = MakeMobilityOperator(params, options);
+  const double step_angle = 1.6e-3;
+  for (int k = 0; k < 37; ++k) {
+    const std::vector<Matrix3X> x = TurnedHelices(k * step_angle);
+    run->Update(Rods(x));
+  }
+  const long assemblies_before = run->reuse_stats().assemblies;
+  run->AtRestartPoint();
+  const MobilityReuseHistory kept = run->reuse_history();
+  ASSERT_EQ(kept.assemblies, 2);  // extrapolating: base and slope held, some updates since
+  ASSERT_GT(kept.interval, 2);
+  ASSERT_GT(kept.since, 0);
+  const auto resumed = MakeMobilityOperator(params, options);
+  resumed->RestoreReuse(kept);
+  long restored_extra = -1;  // the resumed operator's assemblies beyond the run's
+  for (int k = 37; k < 120; ++k) {
+    const std::vector<Matrix3X> x = TurnedHelices(k * step_angle);
+    run->Update(Rods(x));
+    resumed->Update(Rods(x));
+    if (restored_extra < 0) restored_extra = resumed->reuse_stats().assemblies - (run->reuse_stats().assemblies - assemblies_before);
+    EXPECT_EQ(resumed->reuse_stats().assemblies - restored_extra,
+              run->reuse_stats().assemblies - assemblies_before) << "update " << k;
+    ASSERT_EQ((*run->matrix() - *resumed->matrix()).cwiseAbs().maxCoeff(), 0.0) << "update " << k;
+  }
+  EXPECT_EQ(restored_extra, 2);  // the history's two matrices
+  // The run kept extrapolating across its restart point: 83 updates, a few assemblies.
+  EXPECT_LT(run->reuse_stats().assemblies - assemblies_before, 83 / 4);
+}
+
+// A history of another size (another model) is dropped: the operator starts over.
+TEST(MobilityReuse, RestoredHistoryOfAnotherSizeIsDropped) {
+  FluidParams params;
+  MobilityOptions options;
+  options.reuse_tolerance = 1e-4;
+  const auto op = MakeMobilityOperator(params, options);
+  MobilityReuseHistory other{.assemblies = 2, .since = 1, .interval = 4,
+                             .x_a = VecX::Zero(9), .x_b = VecX::Ones(9)};
+  op->RestoreReuse(other);
+  const std::vector<Matrix3X> x = TurnedHelices(0.0);
+  op->Update(Rods(x));
+  MatX exact;
+  AssembleMobility(params, Rods(x), &exact);
+  EXPECT_EQ(op->reuse_stats().assemblies, 1);
+  EXPECT_EQ((*op->matrix() - exact).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(op->reuse_history().assemblies, 1);
+}
+
 }  // namespace
 }  // namespace stokesrods

@@ -74,6 +74,22 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"euler_rft", 1, 15, 0.01, "model = \"rft\"", ""}),
     [](const ::testing::TestParamInfo<Case>& p) { return std::string(p.param.name); });
 
+// At h = 0.2 ms the dense 𝕄 is extrapolated between assemblies (fluid/mobility_reuse.h): at the
+// restart point its history is kept (not forgotten), goes to the fresh Workspace through the
+// StepHistory and is assembled again there; the continuation is still bit-identical.
+TEST(Restart, KeptMobilityReuseContinuesBitIdentically) {
+  const std::string toml = testing::SmallHelicesToml(2, 15, 900, "model = \"rss\"", "");
+  const Model model = testing::ModelFromToml(toml);
+  State state = MakeRestState(model);
+  Workspace ws(model);
+  for (int k = 0; k < 40; ++k) ASSERT_TRUE(Step(model, 2e-4, &state, &ws).ok);
+  ForgetReuse(&ws);
+  const StepHistory history = CaptureHistory(ws);
+  ASSERT_EQ(history.mobility_reuse.assemblies, 2);
+  ASSERT_GT(history.mobility_reuse.interval, 1);  // extrapolating
+  EXPECT_EQ(RestartDifference(toml, 2e-4, 40, 40), 0.0);
+}
+
 // Without ForgetReuse the reused factors make the continuation differ (within the Newton
 // tolerance, not bitwise): the test above would catch a ForgetReuse that forgets nothing.
 TEST(Restart, ReusedFactorsChangeTheContinuationWhenNotForgotten) {

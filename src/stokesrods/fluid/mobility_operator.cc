@@ -52,8 +52,18 @@ class DenseMobility final : public MobilityOperator {
     for (int r = 0; r < num_rods(); ++r)
       x.segment(3 * node_offset(r), 3 * rods[static_cast<size_t>(r)].x->cols()) =
           rods[static_cast<size_t>(r)].x->reshaped();
-    single_current_ =
-        !reuse_.Update(x, [&](MatX* m) { AssembleMobility(params_, rods, m); }, &matrix_, &single_);
+    // 𝕄 with the rods' nodes at `at`: their own positions, or a restored history's.
+    const auto assemble = [&](const VecX& at, MatX* m) {
+      std::vector<Matrix3X> moved(rods.size());
+      std::vector<HydroRod> moved_rods = rods;
+      for (int r = 0; r < num_rods(); ++r) {
+        const auto k = static_cast<size_t>(r);
+        moved[k] = Eigen::Map<const Matrix3X>(at.data() + 3 * node_offset(r), 3, rods[k].x->cols());
+        moved_rods[k].x = &moved[k];
+      }
+      AssembleMobility(params_, moved_rods, m);
+    };
+    single_current_ = !reuse_.Update(x, assemble, &matrix_, &single_);
     double_stale_ = single_current_;
   }
   void UpdateWithBodies(const std::vector<HydroRod>& rods,
@@ -69,6 +79,9 @@ class DenseMobility final : public MobilityOperator {
     matrix_ = AssembleBorderedMobility(params_, rods, bodies);
   }
   void ForgetHistory() override { reuse_.Forget(); }
+  void AtRestartPoint() override {}  // the reuse's history goes into the checkpoint
+  MobilityReuseHistory reuse_history() const override { return reuse_.history(); }
+  void RestoreReuse(const MobilityReuseHistory& history) override { reuse_.Restore(history); }
   MobilityReuseStats reuse_stats() const override { return reuse_.stats(); }
   void Apply(const VecX& force, VecX* velocity) const override {
     // Row blocks in parallel: the product streams the whole matrix (memory bound beyond cache).

@@ -106,9 +106,19 @@ class MobilityOperator {
   /// 𝕄 in single precision when the last Update made it so (the dense 𝕄 extrapolated by its
   /// reuse, fluid/mobility_reuse.h), else nullptr: for what reads it in single precision anyway.
   virtual const Eigen::MatrixXf* single_matrix() const { return nullptr; }
-  /// Forgets what the operator keeps from earlier Updates (a restart point: the next Update
-  /// then depends on its geometry alone).
+  /// Forgets what the operator keeps from earlier Updates: the next Update then depends on its
+  /// geometry alone.
   virtual void ForgetHistory() {}
+  /// A restart point (io/runner.h): forgets what reuse_history() does not keep, so that the next
+  /// Updates depend on the geometry and that history alone (matrix-free: the split is chosen
+  /// again; dense: nothing is forgotten).
+  virtual void AtRestartPoint() { ForgetHistory(); }
+  /// The dense 𝕄's reuse history (fluid/mobility_reuse.h) as a checkpoint keeps it; empty for
+  /// the other operators.
+  virtual MobilityReuseHistory reuse_history() const { return {}; }
+  /// Takes back a history of reuse_history(): the next Update assembles 𝕄 at its geometries
+  /// again and goes on as the operator it was taken from.
+  virtual void RestoreReuse(const MobilityReuseHistory& /*history*/) {}
   /// Reuse of 𝕄 across Updates, counted since the operator was made.
   virtual MobilityReuseStats reuse_stats() const { return {}; }
   /// Matrix-free: the work of one product at the last Update (zeros for the dense operator).

@@ -46,13 +46,30 @@ double TakeAssembly(Eigen::Index n, const double* exact, double s, bool measure,
 
 }  // namespace
 
-bool MobilityReuse::Update(const VecX& x, const std::function<void(MatX*)>& assemble,
-                           MatX* assembled, Eigen::MatrixXf* extrapolated) {
+bool MobilityReuse::Update(const VecX& x, const Assemble& assemble, MatX* assembled,
+                           Eigen::MatrixXf* extrapolated) {
   ++stats_.updates;
   if (tolerance_ <= 0.0) {
-    assemble(assembled);
+    assemble(x, assembled);
     ++stats_.assemblies;
     return true;
+  }
+  if (restore_) {  // the history as it was: its assemblies again, then its counters
+    const MobilityReuseHistory kept = std::move(*restore_);
+    restore_.reset();
+    history_ = 0;
+    if (kept.assemblies >= 1 && kept.x_b.size() == x.size()) {
+      if (kept.assemblies == 2) {
+        assemble(kept.x_a, assembled);
+        ++stats_.assemblies;
+        Take(kept.x_a, *assembled, false);
+      }
+      assemble(kept.x_b, assembled);
+      ++stats_.assemblies;
+      Take(kept.x_b, *assembled, false);
+      since_ = kept.since;
+      interval_ = kept.interval;
+    }
   }
   const bool same_size = base_x_.size() == x.size();
   if (history_ == 2 && same_size && since_ + 1 < interval_) {
@@ -63,20 +80,23 @@ bool MobilityReuse::Update(const VecX& x, const std::function<void(MatX*)>& asse
     return false;
   }
   if (!same_size) history_ = 0;
-  assemble(assembled);
+  assemble(x, assembled);
   ++stats_.assemblies;
-  const Eigen::Index rows = assembled->rows(), cols = assembled->cols();
-  const bool measure = history_ == 2;
+  Take(x, *assembled, history_ == 2);
+  return true;
+}
+
+void MobilityReuse::Take(const VecX& x, const MatX& assembled, bool measure) {
   if (history_ == 0) {
-    base_.resize(rows, cols);
-    slope_.resize(rows, cols);
-    last_assembled_.resize(rows, cols);
+    base_.resize(assembled.rows(), assembled.cols());
+    slope_.resize(assembled.rows(), assembled.cols());
+    last_assembled_.resize(assembled.rows(), assembled.cols());
   }
   // What the extrapolation gives here, since_ + 1 updates from base_ (one more than the farthest
   // used since base_, so it bounds them), rounding included.
   const double s = measure ? Projection(x) : 0.0;
   double norm2 = 0.0;
-  const double miss = std::sqrt(TakeAssembly(assembled->size(), assembled->data(), s, measure,
+  const double miss = std::sqrt(TakeAssembly(assembled.size(), assembled.data(), s, measure,
                                              history_ >= 1, base_.data(), slope_.data(),
                                              last_assembled_.data(), &norm2));
   if (measure) {
@@ -87,17 +107,36 @@ bool MobilityReuse::Update(const VecX& x, const std::function<void(MatX*)>& asse
     interval_ = std::clamp(static_cast<int>(std::floor(used * std::min(grow, 2.0))), 1,
                            kMaxInterval);
   }
-  if (history_ >= 1) step_x_ = x - base_x_;
+  if (history_ >= 1) {
+    previous_x_ = base_x_;
+    step_x_ = x - base_x_;
+  }
   base_x_ = x;
   history_ = std::min(history_ + 1, 2);
   since_ = 0;
-  return true;
 }
 
 void MobilityReuse::Forget() {
   history_ = 0;
   since_ = 0;
   interval_ = 1;
+  restore_.reset();
+}
+
+MobilityReuseHistory MobilityReuse::history() const {
+  if (restore_) return *restore_;  // not assembled again yet
+  MobilityReuseHistory kept;
+  kept.assemblies = tolerance_ > 0.0 ? history_ : 0;
+  kept.since = since_;
+  kept.interval = interval_;
+  if (kept.assemblies >= 1) kept.x_b = base_x_;
+  if (kept.assemblies == 2) kept.x_a = previous_x_;
+  return kept;
+}
+
+void MobilityReuse::Restore(const MobilityReuseHistory& history) {
+  Forget();
+  if (tolerance_ > 0.0 && history.assemblies > 0) restore_ = history;
 }
 
 double MobilityReuse::Projection(const VecX& x) const {

@@ -14,8 +14,13 @@
 // a one-step extrapolation measured for free, until it is small enough (e ≤ 0.2 tolerance) for
 // m = 2, and so on: no extrapolation goes more than twice as far as one whose error was measured.
 // A large step (e(1) > 0.2 tolerance) assembles at every step, exactly as without reuse. Forget
-// drops the history (a restart point: the next steps then depend on the state alone). The largest e
-// measured is kept in the statistics (an interval is shortened after the fact, not redone).
+// drops the history. The largest e measured is kept in the statistics (an interval is shortened
+// after the fact, not redone).
+//
+// RESTART. A checkpoint keeps the history without its matrices (MobilityReuseHistory: where the
+// last two assemblies were taken, the counters); Restore assembles 𝕄 there again, bit for bit the
+// matrices the uninterrupted run holds, so a run need not forget the history at its restart
+// points (forgetting costs the ramp of assemblies above, every 60 steps).
 //
 // PRECISION. An assembled 𝕄 is given as it is (double). The history 𝕄_b, 𝕄_b − 𝕄_a and the
 // extrapolated 𝕄 are kept in single precision: their rounding (6e-8 relative) is part of the e
@@ -25,6 +30,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 
 #include "stokesrods/common/types.h"
 
@@ -36,24 +42,43 @@ struct MobilityReuseStats {
   double largest_error = 0.0;   ///< largest e measured (relative Frobenius)
 };
 
+/// The reuse's history short of its matrices: what a checkpoint keeps (io/checkpoint.h).
+struct MobilityReuseHistory {
+  int assemblies = 0;  ///< held since the last Forget: 0, 1 or 2 (base and slope)
+  int since = 0;       ///< updates since the last assembly
+  int interval = 1;    ///< updates from one assembly to the next
+  VecX x_a;            ///< the geometry of the assembly before the last (assemblies = 2)
+  VecX x_b;            ///< the geometry of the last assembly (assemblies ≥ 1)
+};
+
 class MobilityReuse {
  public:
+  /// Assembles 𝕄 at the node positions x (3M) into its second argument.
+  using Assemble = std::function<void(const VecX& x, MatX*)>;
+
   /// The most steps between two assemblies.
   static constexpr int kMaxInterval = 20;
 
   explicit MobilityReuse(double tolerance) : tolerance_(tolerance) {}
 
-  /// 𝕄 at the node positions x (3M): assembled by `assemble` (which writes 𝕄(x) into its
-  /// argument) into `assembled` (returns true), or extrapolated into `extrapolated` (single
-  /// precision; returns false). With tolerance 0 it always assembles.
-  bool Update(const VecX& x, const std::function<void(MatX*)>& assemble, MatX* assembled,
+  /// 𝕄 at the node positions x (3M): assembled by `assemble` into `assembled` (returns true), or
+  /// extrapolated into `extrapolated` (single precision; returns false). With tolerance 0 it
+  /// always assembles. After Restore it first assembles the restored history again.
+  bool Update(const VecX& x, const Assemble& assemble, MatX* assembled,
               Eigen::MatrixXf* extrapolated);
   /// Drops the history: the next Update assembles.
   void Forget();
+  /// The history as a checkpoint keeps it.
+  MobilityReuseHistory history() const;
+  /// Takes a history kept by history(): the next Update assembles 𝕄 at its geometries first, then
+  /// goes on as the reuse it was taken from would (a history of another size is dropped there).
+  void Restore(const MobilityReuseHistory& history);
   const MobilityReuseStats& stats() const { return stats_; }
 
  private:
   double Projection(const VecX& x) const;
+  /// Takes the assembled 𝕄(x) into the history; measures the extrapolation's miss when `measure`.
+  void Take(const VecX& x, const MatX& assembled, bool measure);
 
   double tolerance_ = 0.0;
   int history_ = 0;    ///< assemblies since Forget (0, 1, 2 = base and slope known)
@@ -63,7 +88,9 @@ class MobilityReuse {
   Eigen::MatrixXf slope_;  ///< 𝕄_b − 𝕄_a (rounded once, from double)
   MatX last_assembled_;    ///< 𝕄_b in double
   VecX base_x_;        ///< x_b
+  VecX previous_x_;    ///< x_a
   VecX step_x_;        ///< x_b − x_a
+  std::optional<MobilityReuseHistory> restore_;  ///< to assemble again at the next Update
   MobilityReuseStats stats_;
 };
 

@@ -12,7 +12,8 @@ namespace stokesrods {
 namespace {
 
 constexpr char kMagic[8] = {'S', 'R', 'C', 'K', 'P', 'T', '\0', '\0'};
-constexpr std::uint32_t kVersion = 5;  // 4: the earlier drags; 5: the bodies' previous poses
+// 4: the earlier drags; 5: the bodies' previous poses; 6: the dense 𝕄's reuse history
+constexpr std::uint32_t kVersion = 6;
 constexpr std::uint32_t kOldestVersion = 2;  // without the controls
 
 std::uint64_t Fnv1a(const char* data, std::size_t bytes, std::uint64_t hash = 14695981039346656037ull) {
@@ -160,6 +161,12 @@ void SaveCheckpoint(const std::string& path, const Model& model, const Checkpoin
     w.Raw(pose.center.data(), 3 * sizeof(double));
     w.Raw(pose.rotation.data(), 9 * sizeof(double));
   }
+  const MobilityReuseHistory& reuse = c.history.mobility_reuse;  // version 6
+  w.Put(static_cast<std::int64_t>(reuse.assemblies));
+  w.Put(static_cast<std::int64_t>(reuse.since));
+  w.Put(static_cast<std::int64_t>(reuse.interval));
+  w.Vector(reuse.x_a);
+  w.Vector(reuse.x_b);
   w.Put(Fnv1a(w.text().data(), w.text().size()));
   WriteFileAtomically(path, w.text());
 }
@@ -227,6 +234,22 @@ Checkpoint LoadCheckpoint(const std::string& path, const Model& model) {
       r.Raw(pose.center.data(), 3 * sizeof(double));
       r.Raw(pose.rotation.data(), 9 * sizeof(double));
     }
+  }
+  if (version >= 6) {  // the dense 𝕄's reuse: where its history was assembled, its counters
+    MobilityReuseHistory& reuse = c.history.mobility_reuse;
+    const auto assemblies = r.Get<std::int64_t>(), since = r.Get<std::int64_t>(),
+               interval = r.Get<std::int64_t>();
+    if (assemblies < 0 || assemblies > 2 || since < 0 || interval < 1 ||
+        interval > MobilityReuse::kMaxInterval || since >= interval)
+      r.Fail(fmt::format("a reuse history of {} assemblies, {} of {} updates is not one", assemblies,
+                         since, interval));
+    reuse.assemblies = static_cast<int>(assemblies);
+    reuse.since = static_cast<int>(since);
+    reuse.interval = static_cast<int>(interval);
+    reuse.x_a = r.Vector(3 * model.num_nodes, "the reuse's geometry x_a", true);
+    reuse.x_b = r.Vector(3 * model.num_nodes, "the reuse's geometry x_b", true);
+    if ((reuse.x_b.size() != 0) != (assemblies >= 1) || (reuse.x_a.size() != 0) != (assemblies == 2))
+      r.Fail("the reuse's geometries do not match its count of assemblies");
   }
   if (r.at() + sizeof stored_sum != text.size()) r.Fail("unexpected data after the contents");
   return c;

@@ -4,7 +4,9 @@
 // previous q, q̇ and h, the drag's first guess), the run's counters, and what identifies the
 // model it belongs to. The factors and preconditioners a run reuses across steps are not saved:
 // the run forgets them at every restart point (sim/integrator.h ForgetReuse), so a resumed run,
-// which starts without them, rebuilds the same ones at the same step (docs/reliability.md).
+// which starts without them, rebuilds the same ones at the same step (docs/reliability.md). The
+// dense 𝕄's reuse is kept instead: the checkpoint holds where its last two assemblies were taken,
+// and the resumed run assembles them again (fluid/mobility_reuse.h).
 //
 // Since version 3 it also holds the controls a caller may change between steps (each rod's
 // rotation rate and point loads; Simulation::SetOmega, SetLoads), which the model fingerprint
@@ -14,9 +16,10 @@
 // read; resumed from them, the first steps start from a less extrapolated guess, which changes
 // the result within the Newton tolerance only. Version 5 adds the bodies' poses at t_{k−1} (BDF2
 // with free bodies); resumed from an older file, BDF2 with free bodies takes one implicit Euler
-// step first.
+// step first. Version 6 adds the dense 𝕄's reuse history; resumed from an older file, the reuse
+// starts over (a few more assemblies; the result changes within the reuse's tolerance).
 //
-// Format (little-endian, version 5): "SRCKPT\0\0", uint32 version, the payload, then the FNV-1a
+// Format (little-endian, version 6): "SRCKPT\0\0", uint32 version, the payload, then the FNV-1a
 // 64-bit hash of everything before it. Written atomically (temporary file, then rename); a
 // damaged, truncated, foreign or other-version file is refused with an IoError naming it.
 #pragma once

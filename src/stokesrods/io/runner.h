@@ -34,10 +34,10 @@ struct RunOptions {
 /// Restart points: after every kRestartSteps-th step and every checkpoint step a run forgets the
 /// factors it reuses across steps (sim/integrator.h ForgetReuse), so that a run resumed there
 /// continues bit for bit. A multiple of the Krylov preconditioner's own largest age (20): no extra
-/// rebuilds of it. Every restart point also drops the dense 𝕄's reuse history, which takes a few
-/// assemblies to build again: 60 instead of 20 steps apart, Fig. 1 at h = 1 ms assembles 0.13
-/// times per step instead of 0.3 and costs 12 % less (docs/performance.md); an interrupt then
-/// waits up to 60 steps.
+/// rebuilds of it. The dense 𝕄's reuse history is not forgotten but kept in the checkpoint (until
+/// 2026-11-25 it was dropped here, and rebuilding it took a few assemblies: restart points were
+/// put 60 instead of 20 steps apart for it); the matrix-free operator chooses its near/far split
+/// again (fluid/mobility_operator.h). An interrupt waits up to 60 steps.
 constexpr long kRestartSteps = 60;
 
 struct RunResult {

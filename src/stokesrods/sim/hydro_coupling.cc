@@ -137,7 +137,7 @@ void HydroCoupling::ForgetReuse(const VecX& drag_guess) {
   explicit_blocks_.reset();
   explicit_blocks_age_ = 0;
   explicit_force_ = drag_guess;
-  if (mobility_) mobility_->ForgetHistory();
+  if (mobility_) mobility_->AtRestartPoint();
 }
 
 void HydroCoupling::AddNodalForce(const Model& model, const VecX& f, VecX* force) {

@@ -93,8 +93,12 @@ class HydroCoupling {
 
   /// Forgets the preconditioners kept across steps, as a fresh HydroCoupling would have none,
   /// and takes `drag_guess` (3M, or empty) as the explicit drag's first GMRES guess. After it the
-  /// next steps depend only on the state and the guess: the point a checkpoint resumes from.
+  /// next steps depend only on the state, the guess and the dense 𝕄's reuse history
+  /// (mobility_reuse_history, which is kept): the point a checkpoint resumes from.
   void ForgetReuse(const VecX& drag_guess);
+  /// The dense 𝕄's reuse history (fluid/mobility_reuse.h) for a checkpoint, and taking it back.
+  MobilityReuseHistory mobility_reuse_history() const { return mobility_->reuse_history(); }
+  void RestoreMobilityReuse(const MobilityReuseHistory& history) { mobility_->RestoreReuse(history); }
 
   const MobilityOperator& mobility() const { return *mobility_; }
   /// The worst Krylov solve since the last call to ResetSolveReport (for failure messages).

@@ -25,8 +25,13 @@ Workspace::Workspace(const Model& model) : local_forces(MakeLocalForces(model)) 
 }
 
 StepHistory CaptureHistory(const Workspace& ws) {
-  return {ws.previous_q, ws.previous_velocity, ws.previous_h,
-          ws.nonlocal_fluid ? ws.hydro_force : VecX(), ws.earlier_drags, ws.previous_poses};
+  return {ws.previous_q,
+          ws.previous_velocity,
+          ws.previous_h,
+          ws.nonlocal_fluid ? ws.hydro_force : VecX(),
+          ws.earlier_drags,
+          ws.previous_poses,
+          ws.nonlocal_fluid ? ws.hydro.mobility_reuse_history() : MobilityReuseHistory{}};
 }
 
 void RestoreHistory(const StepHistory& history, Workspace* ws) {
@@ -37,6 +42,7 @@ void RestoreHistory(const StepHistory& history, Workspace* ws) {
   if (ws->nonlocal_fluid) ws->hydro_force = history.hydro_force;
   ws->earlier_drags = history.earlier_drags;
   ForgetReuse(ws);
+  if (ws->nonlocal_fluid) ws->hydro.RestoreMobilityReuse(history.mobility_reuse);
 }
 
 void ForgetReuse(Workspace* ws) {

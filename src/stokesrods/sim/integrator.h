@@ -104,6 +104,7 @@ struct StepHistory {
   VecX hydro_force;         ///< the nodal drag of the last step (3M; empty without a nonlocal fluid)
   std::array<VecX, 2> earlier_drags;  ///< the drag at t_{k−1}, t_{k−2} (Workspace)
   std::vector<BodyPose> previous_poses;  ///< the bodies at t_{k−1} (empty before the first step)
+  MobilityReuseHistory mobility_reuse;   ///< the dense 𝕄's reuse (assembled again on restore)
 };
 StepHistory CaptureHistory(const Workspace& ws);
 void RestoreHistory(const StepHistory& history, Workspace* ws);
@@ -111,7 +112,9 @@ void RestoreHistory(const StepHistory& history, Workspace* ws);
 /// Forgets every factorization and preconditioner kept across steps (the Newton matrix and its
 /// age, the Krylov preconditioner of the drag): the next step rebuilds them, as it would in a
 /// fresh Workspace. A run calls it at each checkpoint, so that a run resumed from the checkpoint
-/// (a fresh Workspace with the saved StepHistory) steps exactly as the uninterrupted one.
+/// (a fresh Workspace with the saved StepHistory) steps exactly as the uninterrupted one. The
+/// dense 𝕄's reuse is not forgotten: its history is in the StepHistory, and RestoreHistory
+/// assembles its matrices again.
 void ForgetReuse(Workspace* ws);
 
 /// What depends on the start of a step only: the local forces' caches, the mobility 𝕄 at q_k (and
