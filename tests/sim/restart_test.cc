@@ -85,7 +85,7 @@ TEST(Restart, KeptMobilityReuseContinuesBitIdentically) {
   for (int k = 0; k < 40; ++k) ASSERT_TRUE(Step(model, 2e-4, &state, &ws).ok);
   ForgetReuse(&ws);
   const StepHistory history = CaptureHistory(ws);
-  ASSERT_EQ(history.mobility_reuse.assemblies, 2);
+  ASSERT_GE(history.mobility_reuse.geometries.size(), 2u);
   ASSERT_GT(history.mobility_reuse.interval, 1);  // extrapolating
   EXPECT_EQ(RestartDifference(toml, 2e-4, 40, 40), 0.0);
 }

@@ -1,6 +1,11 @@
 // The fast hydrodynamic paths against the reference they replace, on whole time series:
-//   reference : dense 𝕄, the capacitance C = h𝕄 + S X by a fresh dense LU at every step;
+//   reference : dense 𝕄 assembled at every step, the capacitance C = h𝕄 + S X by a fresh dense
+//               LU at every step;
 //   krylov    : dense 𝕄, C by GMRES preconditioned with a kept LU (the default up to 500 nodes);
+//   reuse     : dense 𝕄 extrapolated between assemblies (fluid/mobility_reuse.h; on by default),
+//               compared with 𝕄 assembled at every step on its own (it is left off where the
+//               solvers are compared: it makes 𝕄 depend on where the assemblies fall, which a
+//               solver's own differences can move);
 //   matrix_free: 𝕄 never formed (exact near pairs, Gauss far field, Stokeslet sum), GMRES with
 //               per-rod block preconditioning (the default above 500 nodes).
 // All solve the same discrete equations; the fast ones stop GMRES at the Newton tolerance, and
@@ -103,8 +108,9 @@ base = [0.03, 0.0, 0.0]
 }
 
 TEST(FastPath, Fig1TwoFlagella) {
-  const Series ref = RunSeries(Fig1("mobility = \"dense\"\nsolver = \"direct\"", 65), 60, 10);
-  Compare(ref, RunSeries(Fig1("mobility = \"dense\"\nsolver = \"krylov\"", 65), 60, 10), 0.01,
+  const std::string dense = "mobility = \"dense\"\nmobility_reuse_tolerance = 0\n";
+  const Series ref = RunSeries(Fig1(dense + "solver = \"direct\"", 65), 60, 10);
+  Compare(ref, RunSeries(Fig1(dense + "solver = \"krylov\"", 65), 60, 10), 0.01,
           "Fig. 1, dense + GMRES");
   Compare(ref, RunSeries(Fig1(kStrictMatrixFree, 65), 60, 10), 0.01,
           "Fig. 1, matrix-free (far field 1e-8) + GMRES");
@@ -116,7 +122,8 @@ TEST(FastPath, Fig1TwoFlagella) {
 // precision between assemblies, fluid/mobility_reuse.h), against 𝕄 assembled at every step (both
 // by GMRES: Fig1TwoFlagella checks that against the direct LU). The reuse's tolerance bounds the
 // relative error of 𝕄; the time series then differ in proportion to it (measured over these 100
-// steps: 4.8e-5 R at 1e-4, 3.3e-6 R at 1e-5). Allowed: 2 × tolerance × R and of the largest
+// steps: 2.8e-5 R at 1e-4, 3.0e-6 R at 1e-5; with the linear extrapolation before 2026-11-25,
+// 4.8e-5 and 3.3e-6). Allowed: 2 × tolerance × R and of the largest
 // clamp load, and ten times the tolerance at least five times the difference (a reuse that
 // ignored its tolerance would not scale).
 TEST(FastPath, Fig1AtOneMillisecondWithTheReusedMobility) {
@@ -138,6 +145,16 @@ TEST(FastPath, Fig1AtOneMillisecondWithTheReusedMobility) {
   Compare(reference, coarse, 0.01, "Fig. 1 at 1 ms, dense 𝕄 reused at 1e-4", 2e-4);
   Compare(reference, fine, 0.01, "Fig. 1 at 1 ms, dense 𝕄 reused at 1e-5", 2e-5);
   EXPECT_GT(largest(coarse), 5.0 * largest(fine));
+}
+
+// The same at h = 10 ms (60 steps), where the quadratic extrapolation reuses 𝕄 too (the linear
+// one assembled at every step there: tests/fluid/mobility_reuse_test.cc): within 2 × tolerance.
+TEST(FastPath, Fig1AtTenMillisecondsWithTheReusedMobility) {
+  auto with = [](const std::string& tolerance) {
+    return RunSeries(Fig1("mobility = \"dense\"\nmobility_reuse_tolerance = " + tolerance, 65),
+                     60, 10);
+  };
+  Compare(with("0"), with("1e-4"), 0.01, "Fig. 1 at 10 ms, dense 𝕄 reused at 1e-4", 2e-4);
 }
 
 // The explicit coupling (paper Algorithm 1) solves 𝕄 f = −U once per step: dense LU against
@@ -222,8 +239,9 @@ enabled = true
     t.replace(t.find("FLUID"), 5, fluid);
     return t;
   };
-  const Series ref = RunSeries(with("mobility = \"dense\"\nsolver = \"direct\""), 20, 5);
-  Compare(ref, RunSeries(with("mobility = \"dense\"\nsolver = \"krylov\""), 20, 5), 0.01,
+  const std::string dense = "mobility = \"dense\"\nmobility_reuse_tolerance = 0\n";
+  const Series ref = RunSeries(with(dense + "solver = \"direct\""), 20, 5);
+  Compare(ref, RunSeries(with(dense + "solver = \"krylov\""), 20, 5), 0.01,
           "10 flagella, dense + GMRES");
   Compare(ref, RunSeries(with(kStrictMatrixFree), 20, 5), 0.01,
           "10 flagella, matrix-free (far field 1e-8) + GMRES");
@@ -266,7 +284,8 @@ point = [-0.02, 0.0, 0.0]
 normal = [1.0, 0.0, 0.0]
 )";
   };
-  const Series ref = RunSeries(with("mobility = \"dense\"\nsolver = \"direct\""), 30, 10);
+  const Series ref =
+      RunSeries(with("mobility = \"dense\"\nmobility_reuse_tolerance = 0\nsolver = \"direct\""), 30, 10);
   Compare(ref, RunSeries(with(kStrictMatrixFree), 30, 10), 0.01,
           "helix near a wall, matrix-free (far field 1e-8) + GMRES");
   Compare(ref, RunSeries(with("mobility = \"matrix_free\""), 30, 10), 0.01,

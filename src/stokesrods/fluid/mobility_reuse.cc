@@ -11,35 +11,65 @@ namespace {
 // loops marked `omp simd`): one per step (forming the extrapolation) or per assembly (taking it
 // into the history), over all 9M² entries; as Eigen expressions they were 10 % of Fig. 1's step.
 
-// out = base + s · slope (n entries).
+// out = base + s · slope + c · curve (curve only when given; c = s (s + 1)), n entries.
 __attribute__((target_clones("avx512f", "avx2", "default")))
-void Extrapolate(Eigen::Index n, const float* base, float s, const float* slope, float* out) {
+void Extrapolate(Eigen::Index n, const float* base, float s, const float* slope, float c,
+                 const float* curve, float* out) {
+  if (curve) {
 #pragma omp simd
-  for (Eigen::Index i = 0; i < n; ++i) out[i] = base[i] + s * slope[i];
+    for (Eigen::Index i = 0; i < n; ++i) out[i] = base[i] + s * slope[i] + c * curve[i];
+  } else {
+#pragma omp simd
+    for (Eigen::Index i = 0; i < n; ++i) out[i] = base[i] + s * slope[i];
+  }
 }
 
-// An assembled 𝕄 (`exact`, double) taken into the history in one pass: returns the squared miss
-// Σ (base + s · slope − exact)² of the extrapolation it replaces and Σ exact² in `norm2` (when
-// `measure`), then sets slope = exact − last (when `have_last`; rounded once), base = exact
-// (rounded), last = exact.
+// What one pass over an assembled 𝕄 (`exact`, double) does to the history.
+struct TakePass {
+  bool measure = false;   ///< sum the miss of the extrapolation it replaces (s, c; curve if used)
+  double s = 0.0, c = 0.0;
+  bool use_curve = false;
+  bool new_slope = false; ///< slope = exact − base (there is a base)
+  bool new_curve = false; ///< curve = (slope_new − alpha · slope) · beta (there is a slope)
+  double alpha = 0.0, beta = 0.0;
+};
+
+// An assembled 𝕄 taken into the history in one pass: returns the squared miss
+// Σ (base + s · slope + c · curve − exact)² and Σ exact² in `norm2` (when measuring), then sets
+// curve, slope (against the rounded base) and base = exact (rounded).
 __attribute__((target_clones("avx512f", "avx2", "default")))
-double TakeAssembly(Eigen::Index n, const double* exact, double s, bool measure, bool have_last,
-                    float* base, float* slope, double* last, double* norm2) {
+double TakeAssembly(Eigen::Index n, const double* exact, const TakePass& p, float* base,
+                    float* slope, float* curve, double* norm2) {
   double sum = 0.0, exact2 = 0.0;
-  if (measure) {
+  if (p.measure) {
+    const double cc = p.use_curve ? p.c : 0.0;
+    const float* q = p.use_curve ? curve : slope;  // cc = 0 reads slope twice instead of curve
 #pragma omp simd reduction(+ : sum, exact2)
     for (Eigen::Index i = 0; i < n; ++i) {
-      const double d = static_cast<double>(base[i]) + s * static_cast<double>(slope[i]) - exact[i];
+      const double d = static_cast<double>(base[i]) + p.s * static_cast<double>(slope[i]) +
+                       cc * static_cast<double>(q[i]) - exact[i];
       sum += d * d;
       exact2 += exact[i] * exact[i];
     }
   }
   *norm2 = exact2;
+  if (p.new_curve) {
 #pragma omp simd
-  for (Eigen::Index i = 0; i < n; ++i) {
-    if (have_last) slope[i] = static_cast<float>(exact[i] - last[i]);
-    base[i] = static_cast<float>(exact[i]);
-    last[i] = exact[i];
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double d1 = exact[i] - static_cast<double>(base[i]);
+      curve[i] = static_cast<float>((d1 - p.alpha * static_cast<double>(slope[i])) * p.beta);
+      slope[i] = static_cast<float>(d1);
+      base[i] = static_cast<float>(exact[i]);
+    }
+  } else if (p.new_slope) {
+#pragma omp simd
+    for (Eigen::Index i = 0; i < n; ++i) {
+      slope[i] = static_cast<float>(exact[i] - static_cast<double>(base[i]));
+      base[i] = static_cast<float>(exact[i]);
+    }
+  } else {
+#pragma omp simd
+    for (Eigen::Index i = 0; i < n; ++i) base[i] = static_cast<float>(exact[i]);
   }
   return sum;
 }
@@ -57,67 +87,88 @@ bool MobilityReuse::Update(const VecX& x, const Assemble& assemble, MatX* assemb
   if (restore_) {  // the history as it was: its assemblies again, then its counters
     const MobilityReuseHistory kept = std::move(*restore_);
     restore_.reset();
-    history_ = 0;
-    if (kept.assemblies >= 1 && kept.x_b.size() == x.size()) {
-      if (kept.assemblies == 2) {
-        assemble(kept.x_a, assembled);
+    Forget();
+    const bool fits = std::all_of(kept.geometries.begin(), kept.geometries.end(),
+                                  [&](const VecX& g) { return g.size() == x.size(); });
+    if (fits && !kept.geometries.empty()) {
+      for (const VecX& g : kept.geometries) {
+        assemble(g, assembled);
         ++stats_.assemblies;
-        Take(kept.x_a, *assembled, false);
+        Take(g, *assembled, false);
       }
-      assemble(kept.x_b, assembled);
-      ++stats_.assemblies;
-      Take(kept.x_b, *assembled, false);
       since_ = kept.since;
       interval_ = kept.interval;
     }
   }
-  const bool same_size = base_x_.size() == x.size();
-  if (history_ == 2 && same_size && since_ + 1 < interval_) {
+  const bool same_size = !geometries_.empty() && geometries_.back().size() == x.size();
+  if (geometries_.size() >= 2 && same_size && since_ + 1 < interval_) {
     ++since_;
-    const auto s = static_cast<float>(Projection(x));
+    const double s = Position(x);
     extrapolated->resize(base_.rows(), base_.cols());
-    Extrapolate(base_.size(), base_.data(), s, slope_.data(), extrapolated->data());
+    Extrapolate(base_.size(), base_.data(), static_cast<float>(s), slope_.data(),
+                static_cast<float>(s * (s + 1.0)), quadratic_ ? curve_.data() : nullptr,
+                extrapolated->data());
     return false;
   }
-  if (!same_size) history_ = 0;
+  if (!same_size) Forget();
   assemble(x, assembled);
   ++stats_.assemblies;
-  Take(x, *assembled, history_ == 2);
+  Take(x, *assembled, geometries_.size() >= 2);
   return true;
 }
 
 void MobilityReuse::Take(const VecX& x, const MatX& assembled, bool measure) {
-  if (history_ == 0) {
+  const std::size_t held = geometries_.size();
+  if (held == 0) {
     base_.resize(assembled.rows(), assembled.cols());
     slope_.resize(assembled.rows(), assembled.cols());
-    last_assembled_.resize(assembled.rows(), assembled.cols());
   }
-  // What the extrapolation gives here, since_ + 1 updates from base_ (one more than the farthest
-  // used since base_, so it bounds them), rounding included.
-  const double s = measure ? Projection(x) : 0.0;
+  TakePass pass;
+  pass.measure = measure;
+  // What the extrapolation gives here, since_ + 1 updates from the last assembly (one more than
+  // the farthest used, so it bounds them), rounding included.
+  if (measure) {
+    pass.s = Position(x);
+    pass.c = pass.s * (pass.s + 1.0);
+    pass.use_curve = quadratic_;
+  }
+  pass.new_slope = held >= 1;
+  // The quadratic's D₂ through the new geometry, the last and the one before: s_a of the one
+  // before on the new line (x_last → x).
+  bool quadratic = false;
+  if (held >= 2) {
+    const VecX step = x - geometries_[held - 1];
+    const double length2 = step.squaredNorm();
+    const double s_a = length2 > 0.0 ? (geometries_[held - 2] - x).dot(step) / length2 : 0.0;
+    quadratic = std::abs(1.0 + s_a) >= 0.25 && s_a < -1.0;
+    if (quadratic) {
+      pass.new_curve = true;
+      pass.alpha = 1.0 / (-1.0 - s_a);
+      pass.beta = 1.0 / -s_a;
+      curve_.resize(assembled.rows(), assembled.cols());
+    }
+  }
   double norm2 = 0.0;
-  const double miss = std::sqrt(TakeAssembly(assembled.size(), assembled.data(), s, measure,
-                                             history_ >= 1, base_.data(), slope_.data(),
-                                             last_assembled_.data(), &norm2));
+  const double miss = std::sqrt(TakeAssembly(assembled.size(), assembled.data(), pass,
+                                             base_.data(), slope_.data(), curve_.data(), &norm2));
   if (measure) {
     const double error = miss / std::max(std::sqrt(norm2), 1e-300);
     if (since_ > 0) stats_.largest_error = std::max(stats_.largest_error, error);
     const int used = since_ + 1;
-    const double grow = error > 0.0 ? 0.9 * std::sqrt(tolerance_ / error) : 2.0;
+    const double order = quadratic_ ? 3.0 : 2.0;  // of the extrapolation just measured
+    const double grow = error > 0.0 ? 0.9 * std::pow(tolerance_ / error, 1.0 / order) : 2.0;
     interval_ = std::clamp(static_cast<int>(std::floor(used * std::min(grow, 2.0))), 1,
                            kMaxInterval);
   }
-  if (history_ >= 1) {
-    previous_x_ = base_x_;
-    step_x_ = x - base_x_;
-  }
-  base_x_ = x;
-  history_ = std::min(history_ + 1, 2);
+  quadratic_ = quadratic;
+  if (held == static_cast<std::size_t>(kMaxHeld)) geometries_.erase(geometries_.begin());
+  geometries_.push_back(x);
   since_ = 0;
 }
 
 void MobilityReuse::Forget() {
-  history_ = 0;
+  geometries_.clear();
+  quadratic_ = false;
   since_ = 0;
   interval_ = 1;
   restore_.reset();
@@ -126,22 +177,25 @@ void MobilityReuse::Forget() {
 MobilityReuseHistory MobilityReuse::history() const {
   if (restore_) return *restore_;  // not assembled again yet
   MobilityReuseHistory kept;
-  kept.assemblies = tolerance_ > 0.0 ? history_ : 0;
+  if (tolerance_ <= 0.0) return kept;
   kept.since = since_;
   kept.interval = interval_;
-  if (kept.assemblies >= 1) kept.x_b = base_x_;
-  if (kept.assemblies == 2) kept.x_a = previous_x_;
+  kept.geometries = geometries_;
   return kept;
 }
 
 void MobilityReuse::Restore(const MobilityReuseHistory& history) {
   Forget();
-  if (tolerance_ > 0.0 && history.assemblies > 0) restore_ = history;
+  if (tolerance_ > 0.0 && !history.geometries.empty()) restore_ = history;
 }
 
-double MobilityReuse::Projection(const VecX& x) const {
-  const double length2 = step_x_.squaredNorm();
-  return length2 > 0.0 ? (x - base_x_).dot(step_x_) / length2 : 0.0;
+double MobilityReuse::Position(const VecX& x) const {
+  const std::size_t held = geometries_.size();
+  if (held < 2) return 0.0;
+  const VecX& last = geometries_[held - 1];
+  const VecX step = last - geometries_[held - 2];
+  const double length2 = step.squaredNorm();
+  return length2 > 0.0 ? (x - last).dot(step) / length2 : 0.0;
 }
 
 }  // namespace stokesrods

@@ -1,36 +1,48 @@
 // Reuse of an assembled dense mobility 𝕄 across the geometries of successive time steps, with an
 // a-posteriori control of its error.
 //
-// 𝕄(x) is assembled at some steps only; in between it is extrapolated along the line through the
-// last two assembled geometries x_a, x_b:
-//     𝕄(x) ≈ 𝕄_b + s (𝕄_b − 𝕄_a),   s = ⟨x − x_b, x_b − x_a⟩ / |x_b − x_a|²,
-// the point on that line nearest x (s = (t − t_b)/(t_b − t_a) for a steady motion). Its error is
-// second order in the distance travelled. It is measured at every assembly, where the
-// extrapolation is compared with the exact 𝕄 in the relative Frobenius norm
+// 𝕄(x) is assembled at some steps only; in between it is extrapolated through the last three
+// assembled geometries x_a, x_b, x_c (two at first) as a function of the position s of x on the
+// line through the last two,
+//     s(x) = ⟨x − x_c, x_c − x_b⟩ / |x_c − x_b|²      (s(x_c) = 0, s(x_b) = −1, s(x_a) = s_a),
+// by the quadratic through the three (Newton's form; linear while only two are held):
+//     𝕄(x) ≈ 𝕄_c + s D₁ + s (s + 1) D₂,   D₁ = 𝕄_c − 𝕄_b,
+//     D₂ = (D₁ − (𝕄_b − 𝕄_a)/(−1 − s_a)) / (−s_a)
+// (s = (t − t_c)/(t_c − t_b) for a steady motion, and s_a = −2 for equal intervals). Its error is
+// third order in the distance travelled (second for the linear one). It is measured at every
+// assembly, where the extrapolation is compared with the exact 𝕄 in the relative Frobenius norm
 //     e = ‖𝕄_extrapolated − 𝕄‖_F / ‖𝕄‖_F,
 // and the number of steps to the next assembly is set so that e stays below `tolerance`: e grows
-// like m² with the m steps extrapolated, so m ← m (tolerance / e)^½ × 0.9, at most 2m and
-// kMaxInterval. After the first two assemblies m = 1: 𝕄 is assembled at every step, the error of
-// a one-step extrapolation measured for free, until it is small enough (e ≤ 0.2 tolerance) for
-// m = 2, and so on: no extrapolation goes more than twice as far as one whose error was measured.
-// A large step (e(1) > 0.2 tolerance) assembles at every step, exactly as without reuse. Forget
-// drops the history. The largest e measured is kept in the statistics (an interval is shortened
-// after the fact, not redone).
+// like m^p with the m steps extrapolated (p = 3, or 2 for the linear one), so
+// m ← m (tolerance / e)^(1/p) × 0.9, at most 2m and kMaxInterval. After the first two assemblies
+// m = 1: 𝕄 is assembled at every step, the error of a one-step extrapolation measured for free,
+// until it is small enough for m = 2, and so on: no extrapolation goes more than twice as far as
+// one whose error was measured. A large step (e(1) > 0.45^p tolerance) assembles at every step,
+// exactly as without reuse. The quadratic term is left out (linear) where the
+// interval before the last is under a quarter of the last (|1 + s_a| < 1/4: its divided
+// difference would amplify the history's rounding). Forget drops the history. The largest e
+// measured is kept in the statistics (an interval is shortened after the fact, not redone).
 //
-// RESTART. A checkpoint keeps the history without its matrices (MobilityReuseHistory: where the
-// last two assemblies were taken, the counters); Restore assembles 𝕄 there again, bit for bit the
+// Measured on paper Fig. 1 at h = 1 ms (t = 0.3 s, assembling at every step for the check): 20
+// steps from a history 8 steps apart miss by 9.5e-5 linearly and 4.0e-6 quadratically; 40 steps
+// by 3.3e-4 and 2.1e-5 (docs/performance.md).
+//
+// RESTART. A checkpoint keeps the history without its matrices (MobilityReuseHistory: where its
+// assemblies were taken, the counters); Restore assembles 𝕄 there again, bit for bit the
 // matrices the uninterrupted run holds, so a run need not forget the history at its restart
-// points (forgetting costs the ramp of assemblies above, every 60 steps).
+// points (forgetting costs the ramp of assemblies above).
 //
-// PRECISION. An assembled 𝕄 is given as it is (double). The history 𝕄_b, 𝕄_b − 𝕄_a and the
-// extrapolated 𝕄 are kept in single precision: their rounding (6e-8 relative) is part of the e
-// measured, and below a tolerance of about 3e-7 (e(1) > 0.2 tolerance from the rounding alone) 𝕄
-// is simply assembled at every step. The extrapolated matrix streams half the bytes of a double
-// one in the products, which sum in double (solver/blas.h GemvRowsMixed).
+// PRECISION. An assembled 𝕄 is given as it is (double). The history 𝕄_c, D₁, D₂ and the
+// extrapolated 𝕄 are kept in single precision (D₁ is taken against the rounded 𝕄_c): their
+// rounding (6e-8 relative, a few times that through s and s(s + 1)) is part of the e measured,
+// and below a tolerance of about 1e-6 𝕄 is simply assembled at every step. The extrapolated matrix
+// streams half the bytes of a double one in the products, which sum in double (solver/blas.h
+// GemvRowsMixed).
 #pragma once
 
 #include <functional>
 #include <optional>
+#include <vector>
 
 #include "stokesrods/common/types.h"
 
@@ -44,20 +56,21 @@ struct MobilityReuseStats {
 
 /// The reuse's history short of its matrices: what a checkpoint keeps (io/checkpoint.h).
 struct MobilityReuseHistory {
-  int assemblies = 0;  ///< held since the last Forget: 0, 1 or 2 (base and slope)
   int since = 0;       ///< updates since the last assembly
   int interval = 1;    ///< updates from one assembly to the next
-  VecX x_a;            ///< the geometry of the assembly before the last (assemblies = 2)
-  VecX x_b;            ///< the geometry of the last assembly (assemblies ≥ 1)
+  /// The geometries (3M each) of the assemblies held since the last Forget, oldest first: at
+  /// most kMaxHeld.
+  std::vector<VecX> geometries;
 };
 
 class MobilityReuse {
  public:
   /// Assembles 𝕄 at the node positions x (3M) into its second argument.
   using Assemble = std::function<void(const VecX& x, MatX*)>;
-
   /// The most steps between two assemblies.
-  static constexpr int kMaxInterval = 20;
+  static constexpr int kMaxInterval = 40;
+  /// The most assemblies the extrapolation goes through.
+  static constexpr int kMaxHeld = 3;
 
   explicit MobilityReuse(double tolerance) : tolerance_(tolerance) {}
 
@@ -76,20 +89,19 @@ class MobilityReuse {
   const MobilityReuseStats& stats() const { return stats_; }
 
  private:
-  double Projection(const VecX& x) const;
+  /// s(x) on the line through the last two geometries.
+  double Position(const VecX& x) const;
   /// Takes the assembled 𝕄(x) into the history; measures the extrapolation's miss when `measure`.
   void Take(const VecX& x, const MatX& assembled, bool measure);
 
   double tolerance_ = 0.0;
-  int history_ = 0;    ///< assemblies since Forget (0, 1, 2 = base and slope known)
   int since_ = 0;      ///< updates since the last assembly
   int interval_ = 1;   ///< updates from one assembly to the next
-  Eigen::MatrixXf base_;   ///< 𝕄_b
-  Eigen::MatrixXf slope_;  ///< 𝕄_b − 𝕄_a (rounded once, from double)
-  MatX last_assembled_;    ///< 𝕄_b in double
-  VecX base_x_;        ///< x_b
-  VecX previous_x_;    ///< x_a
-  VecX step_x_;        ///< x_b − x_a
+  std::vector<VecX> geometries_;  ///< of the assemblies held, oldest first (≤ kMaxHeld)
+  bool quadratic_ = false;        ///< curve_ holds D₂
+  Eigen::MatrixXf base_;   ///< 𝕄_c
+  Eigen::MatrixXf slope_;  ///< D₁
+  Eigen::MatrixXf curve_;  ///< D₂
   std::optional<MobilityReuseHistory> restore_;  ///< to assemble again at the next Update
   MobilityReuseStats stats_;
 };

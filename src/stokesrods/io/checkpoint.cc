@@ -162,11 +162,10 @@ void SaveCheckpoint(const std::string& path, const Model& model, const Checkpoin
     w.Raw(pose.rotation.data(), 9 * sizeof(double));
   }
   const MobilityReuseHistory& reuse = c.history.mobility_reuse;  // version 6
-  w.Put(static_cast<std::int64_t>(reuse.assemblies));
+  w.Put(static_cast<std::int64_t>(reuse.geometries.size()));
   w.Put(static_cast<std::int64_t>(reuse.since));
   w.Put(static_cast<std::int64_t>(reuse.interval));
-  w.Vector(reuse.x_a);
-  w.Vector(reuse.x_b);
+  for (const VecX& g : reuse.geometries) w.Vector(g);
   w.Put(Fnv1a(w.text().data(), w.text().size()));
   WriteFileAtomically(path, w.text());
 }
@@ -237,19 +236,16 @@ Checkpoint LoadCheckpoint(const std::string& path, const Model& model) {
   }
   if (version >= 6) {  // the dense 𝕄's reuse: where its history was assembled, its counters
     MobilityReuseHistory& reuse = c.history.mobility_reuse;
-    const auto assemblies = r.Get<std::int64_t>(), since = r.Get<std::int64_t>(),
+    const auto held = r.Get<std::int64_t>(), since = r.Get<std::int64_t>(),
                interval = r.Get<std::int64_t>();
-    if (assemblies < 0 || assemblies > 2 || since < 0 || interval < 1 ||
+    if (held < 0 || held > MobilityReuse::kMaxHeld || since < 0 || interval < 1 ||
         interval > MobilityReuse::kMaxInterval || since >= interval)
-      r.Fail(fmt::format("a reuse history of {} assemblies, {} of {} updates is not one", assemblies,
+      r.Fail(fmt::format("a reuse history of {} assemblies, {} of {} updates is not one", held,
                          since, interval));
-    reuse.assemblies = static_cast<int>(assemblies);
     reuse.since = static_cast<int>(since);
     reuse.interval = static_cast<int>(interval);
-    reuse.x_a = r.Vector(3 * model.num_nodes, "the reuse's geometry x_a", true);
-    reuse.x_b = r.Vector(3 * model.num_nodes, "the reuse's geometry x_b", true);
-    if ((reuse.x_b.size() != 0) != (assemblies >= 1) || (reuse.x_a.size() != 0) != (assemblies == 2))
-      r.Fail("the reuse's geometries do not match its count of assemblies");
+    for (std::int64_t k = 0; k < held; ++k)
+      reuse.geometries.push_back(r.Vector(3 * model.num_nodes, "a geometry of the reuse"));
   }
   if (r.at() + sizeof stored_sum != text.size()) r.Fail("unexpected data after the contents");
   return c;
