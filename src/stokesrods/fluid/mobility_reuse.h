@@ -35,7 +35,7 @@
 // PRECISION. An assembled 𝕄 is given as it is (double). The history 𝕄_c, D₁, D₂ and the
 // extrapolated 𝕄 are kept in single precision (D₁ is taken against the rounded 𝕄_c): their
 // rounding (6e-8 relative, a few times that through s and s(s + 1)) is part of the e measured,
-// and below a tolerance of about 1e-6 𝕄 is simply assembled at every step. The extrapolated matrix
+// and at a tolerance near it 𝕄 is simply assembled at every step (tested at 1e-8; reused at 1e-5). The extrapolated matrix
 // streams half the bytes of a double one in the products, which sum in double (solver/blas.h
 // GemvRowsMixed).
 #pragma once
