@@ -21,7 +21,7 @@
 
 namespace {
 
-// SIGINT/SIGTERM: the first lets the run go on to its next restart point (at most 20 steps) and
+// SIGINT/SIGTERM: the first lets the run go on to its next restart point (at most 120 steps) and
 // checkpoint there, so that --resume continues exactly; a second stops after the current step.
 volatile std::sig_atomic_t g_interrupted = 0;
 void OnSignal(int) { g_interrupted = g_interrupted + 1; }

@@ -37,7 +37,7 @@ struct RunConfig {
   bool frames = true;
   std::string frames_format = "ascii";    ///< "ascii" | "binary" (base64) | "appended" (raw)
   std::optional<double> checkpoint_interval;  ///< [s], default: 1/10 of the run
-  /// [s] of wall time: if set, a checkpoint is written at the first restart point (every 60 steps
+  /// [s] of wall time: if set, a checkpoint is written at the first restart point (every 120 steps
   /// and every checkpoint_interval) after this much wall time since the last one
   std::optional<double> checkpoint_wall_interval;
   /// Stop at the first output row where rod 1 has buckled by analyze's rule (io/analysis.h: its

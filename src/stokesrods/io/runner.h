@@ -33,12 +33,13 @@ struct RunOptions {
 
 /// Restart points: after every kRestartSteps-th step and every checkpoint step a run forgets the
 /// factors it reuses across steps (sim/integrator.h ForgetReuse), so that a run resumed there
-/// continues bit for bit. A multiple of the Krylov preconditioner's own largest age (20): no extra
+/// continues bit for bit. A multiple of the Krylov preconditioner's own largest age (40): no extra
 /// rebuilds of it. The dense 𝕄's reuse history is not forgotten but kept in the checkpoint (until
 /// 2026-11-25 it was dropped here, and rebuilding it took a few assemblies: restart points were
 /// put 60 instead of 20 steps apart for it); the matrix-free operator chooses its near/far split
-/// again (fluid/mobility_operator.h). An interrupt waits up to 60 steps.
-constexpr long kRestartSteps = 60;
+/// again (fluid/mobility_operator.h), which costs a second Update there. 120 steps apart since
+/// 2026-11-25 (60 before): an interrupt waits up to 120 steps.
+constexpr long kRestartSteps = 120;
 
 struct RunResult {
   RunStatus status = RunStatus::kCompleted;

@@ -59,7 +59,10 @@ void AddSchurBlocks(const Model& model, const std::vector<MatX>& sx_blocks, Matr
 
 constexpr int kFullLuBelow = 3000;
 // Steps a Krylov preconditioner is kept at most (it is rebuilt sooner when GMRES slows down).
-constexpr int kPreconditionerMaxAge = 20;
+// 40 since 2026-11-25 (was 20): with the dense 𝕄 extrapolated quadratically, Fig. 1 at h = 1 ms
+// needs 1.85 GMRES products per step at 40 (1.58 at 20, 2.01 at 60), and a rebuild (the Schur
+// blocks and the LU of C) costs as much as ~27 products: 40 is the cheaper (docs/performance.md).
+constexpr int kPreconditionerMaxAge = 40;
 
 void HydroCoupling::Init(const Model& model) {
   mobility_ = MakeModelMobility(model);
@@ -100,7 +103,7 @@ HydroSolveReport HydroCoupling::Prepare(const Model& model, const VecX& q_start,
       explicit_force_.setConstant(std::numeric_limits<double>::quiet_NaN());
     return report;
   }
-  // The self-mobility blocks change little from step to step: rebuilt every 20 steps.
+  // The self-mobility blocks change little from step to step: rebuilt every 40 steps.
   if (!explicit_blocks_ || ++explicit_blocks_age_ >= kPreconditionerMaxAge) {
     explicit_blocks_ = std::make_unique<SelfMobilityPreconditioner>(*mobility_);
     explicit_blocks_age_ = 0;
