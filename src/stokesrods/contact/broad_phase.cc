@@ -78,13 +78,20 @@ void CheckArguments(double margin, int self_exclusion) {
 using CellIndex = std::array<std::int64_t, 3>;
 
 struct CellEntry {
-  CellIndex cell;
+  std::uint64_t cell = 0;  ///< the cell's key (Grid::Key)
   int box = 0;
 };
 
 struct Grid {
+  std::array<std::uint64_t, 3> stride{};  ///< of the key per axis
   std::vector<CellIndex> lower;    ///< per box: cell of its lower corner
   std::vector<CellEntry> entries;  ///< every (cell, box) a box touches, sorted by cell
+
+  /// One integer per cell (row-major over the grid's cells): a single comparison in the sort.
+  std::uint64_t Key(const CellIndex& c) const {
+    return static_cast<std::uint64_t>(c[0]) * stride[0] + static_cast<std::uint64_t>(c[1]) * stride[1] +
+           static_cast<std::uint64_t>(c[2]);
+  }
 };
 
 /// Enters the (≥ 1) boxes in a grid whose cell edge is the largest box extent.
@@ -97,8 +104,11 @@ Grid BuildGrid(const std::vector<Box>& boxes) {
     top = top.cwiseMax(b.hi);
     cell = std::max(cell, (b.hi - b.lo).maxCoeff());
   }
-  // Keep cell indices far inside int64 (and the cell size > 0 when everything is one point).
-  cell = std::max({cell, (top - origin).maxCoeff() * 1e-12, std::numeric_limits<double>::min()});
+  // At most 2^20 cells per axis, so that a cell's key fits in 64 bits (a larger cell is still a
+  // valid grid, only less selective), and the cell size > 0 when everything is one point.
+  constexpr double kMaxCellsPerAxis = 1 << 20;
+  cell = std::max({cell, (top - origin).maxCoeff() / kMaxCellsPerAxis,
+                   std::numeric_limits<double>::min()});
   const auto index_of = [&](const Vec3& x) {
     CellIndex c;
     for (int k = 0; k < 3; ++k) {
@@ -108,6 +118,9 @@ Grid BuildGrid(const std::vector<Box>& boxes) {
   };
 
   Grid grid;
+  const CellIndex last = index_of(top);
+  grid.stride = {static_cast<std::uint64_t>(last[1] + 1) * static_cast<std::uint64_t>(last[2] + 1),
+                 static_cast<std::uint64_t>(last[2] + 1), 1};
   grid.lower.resize(boxes.size());
   std::vector<CellEntry>& entries = grid.entries;
   entries.reserve(8 * boxes.size());
@@ -118,7 +131,7 @@ Grid BuildGrid(const std::vector<Box>& boxes) {
     for (std::int64_t i = lo[0]; i <= hi[0]; ++i) {
       for (std::int64_t j = lo[1]; j <= hi[1]; ++j) {
         for (std::int64_t k = lo[2]; k <= hi[2]; ++k) {
-          entries.push_back({{i, j, k}, static_cast<int>(n)});
+          entries.push_back({grid.Key({i, j, k}), static_cast<int>(n)});
         }
       }
     }
@@ -153,7 +166,7 @@ std::vector<SegmentPair> FindCandidatePairs(const std::vector<const Matrix3X*>& 
   for (std::size_t begin = 0; begin < entries.size();) {
     std::size_t end = begin + 1;
     while (end < entries.size() && entries[end].cell == entries[begin].cell) ++end;
-    const CellIndex& here = entries[begin].cell;
+    const std::uint64_t here = entries[begin].cell;
     for (std::size_t u = begin; u < end; ++u) {
       const int m = entries[u].box;
       for (std::size_t v = u + 1; v < end; ++v) {
@@ -161,7 +174,7 @@ std::vector<SegmentPair> FindCandidatePairs(const std::vector<const Matrix3X*>& 
         ++visited;
         CellIndex owner;
         for (int k = 0; k < 3; ++k) owner[k] = std::max(lower[m][k], lower[n][k]);
-        if (owner != here) continue;  // this pair is tested in another cell
+        if (grid.Key(owner) != here) continue;  // this pair is tested in another cell
         const Box& a = boxes[m];
         const Box& b = boxes[n];
         if (Excluded(a.id, b.id, self_exclusion)) continue;
