@@ -77,6 +77,18 @@ TEST(BroadPhase, EqualsBruteForceOnRandomSoups) {
   EXPECT_GT(total_pairs, 10000u);  // the comparison is not vacuous
 }
 
+// A soup spread over 1e9 times its segments' size: more than 2^20 cells of the segments' extent
+// per axis, so the grid takes larger cells (a cell's key is one 64-bit integer); still every pair
+// the brute force finds, and no other.
+TEST(BroadPhase, ExtentFarBeyondTheSegmentsEqualsBruteForce) {
+  std::mt19937 rng(11);
+  std::vector<Matrix3X> rods = RandomSoup(&rng, 4, 30, 3.0);
+  rods[3].colwise() += Vec3(1e9, -2e9, 5e8);  // one rod far away, the others among themselves
+  EXPECT_EQ(FindCandidatePairs(Pointers(rods), 0.2, 1),
+            FindCandidatePairsBruteForce(Pointers(rods), 0.2, 1));
+  EXPECT_FALSE(FindCandidatePairs(Pointers(rods), 0.2, 1).empty());
+}
+
 TEST(BroadPhase, DegenerateInputs) {
   // No rods, one-node rods, all nodes at one point, a non-finite node.
   EXPECT_TRUE(FindCandidatePairs({}, 0.1, 1).empty());
