@@ -29,14 +29,31 @@ GmresReport SolveGmres(const LinearOperator& a, const LinearOperator& preconditi
     if (preconditioner) preconditioner(in, out); else *out = in;
   };
 
+  // y of the least-squares problem after k iterations (k × k upper triangular, rotated).
+  auto least_squares = [&](int k) {
+    VecX y = g.head(k);
+    for (int i = k - 1; i >= 0; --i) {
+      for (int j = i + 1; j < k; ++j) y(i) -= hess(i, j) * y(j);
+      y(i) = hess(i, i) != 0.0 ? y(i) / hess(i, i) : 0.0;
+    }
+    return y;
+  };
+  // The absolute test in the norm it is asked in (the 2-norm, or the largest component).
+  auto meets_absolute = [&](const VecX& residual, double residual_norm, double margin) {
+    if (options.absolute_tolerance <= 0.0) return false;
+    if (!options.absolute_in_max_norm) return residual_norm <= margin * options.absolute_tolerance;
+    return residual.lpNorm<Eigen::Infinity>() <= margin * options.absolute_tolerance;
+  };
+
   VecX product = VecX::Zero(n);  // A x
   if (!x->isZero(0.0)) a(*x, &product);
   r = b - product;
   double r_norm = r.norm();
+  const double sqrt_n = std::sqrt(static_cast<double>(n));
   while (true) {
     report.relative_residual = r_norm / b_norm;
     report.converged = report.relative_residual <= options.tolerance ||
-                       r_norm <= options.absolute_tolerance;
+                       meets_absolute(r, r_norm, 1.0);
     if (report.converged || report.iterations >= options.max_iterations) {
       if (ax) *ax = product;
       return report;
@@ -72,20 +89,28 @@ GmresReport SolveGmres(const LinearOperator& a, const LinearOperator& preconditi
       hess(k + 1, k) = 0.0;
       g(k + 1) = -sn(k) * g(k);
       g(k) = cs(k) * g(k);
-      // |g(k+1)| is the residual norm of the least-squares problem (in exact arithmetic).
-      if (std::abs(g(k + 1)) <= 0.5 * std::max(options.tolerance * b_norm,
-                                               options.absolute_tolerance) ||
-          hess(k, k) == 0.0) {
+      // |g(k+1)| is the residual norm of the least-squares problem (in exact arithmetic). Half
+      // the tolerance here, so that the residual formed after the cycle meets the whole of it.
+      const double estimate = std::abs(g(k + 1));
+      bool done = estimate <= 0.5 * options.tolerance * b_norm || hess(k, k) == 0.0;
+      if (!done && options.absolute_in_max_norm) {
+        // The largest component is at least the 2-norm / √n: only then is the residual worth
+        // forming (O(n k), no product), b − A x − V_{k+2} H̄ y.
+        if (estimate <= 0.5 * sqrt_n * options.absolute_tolerance) {
+          const VecX y = least_squares(k + 1);
+          const VecX trial = r - v.leftCols(k + 2) * (hess_raw.topLeftCorner(k + 2, k + 1) * y);
+          done = meets_absolute(trial, estimate, 0.5);
+        }
+      } else if (!done) {
+        done = meets_absolute(r, estimate, 0.5);
+      }
+      if (done) {
         ++k;
         break;
       }
     }
     // Back substitution for y (k × k upper triangular), x += Z y.
-    VecX y = g.head(k);
-    for (int i = k - 1; i >= 0; --i) {
-      for (int j = i + 1; j < k; ++j) y(i) -= hess(i, j) * y(j);
-      y(i) = hess(i, i) != 0.0 ? y(i) / hess(i, i) : 0.0;
-    }
+    const VecX y = least_squares(k);
     *x += z.leftCols(k) * y;
     // A x from the Arnoldi relation, A (x + Z y) = A x + V_{k+1} H̄_k y: no extra product, and the
     // residual b − A x is formed explicitly (its norm equals the least-squares estimate up to the

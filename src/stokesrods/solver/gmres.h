@@ -20,6 +20,9 @@ using LinearOperator = std::function<void(const VecX& x, VecX* y)>;
 struct GmresOptions {
   double tolerance = 1e-10;  ///< stop when |b − A x| ≤ tolerance |b|  [–]
   double absolute_tolerance = 0.0;  ///< or when |b − A x| ≤ this (units of b)
+  /// absolute_tolerance bounds the largest component max_i |(b − A x)_i| instead of the 2-norm:
+  /// what a test on every unknown asks (the 2-norm is up to √n times the largest component).
+  bool absolute_in_max_norm = false;
   int max_iterations = 200;  ///< products with A, over all restarts
   int restart = 50;          ///< Krylov dimension before a restart
 };
