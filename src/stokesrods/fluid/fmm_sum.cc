@@ -69,6 +69,24 @@ void Gemm(const MatX& a, bool transpose_a, const MatX& b, double alpha, double b
   dgemm_(&ta, &tb, &m, &n, &k, &alpha, a.data(), &lda, b.data(), &ldb, &beta, c->data(), &ldc);
 }
 
+/// The translations between levels (M2M, L2L) of many boxes: out_j = ops[octant_j] in.col(column_j)
+/// for every entry j, as one BLAS product per octant (the boxes of one octant share the
+/// operator) instead of one matrix–vector product per box. Entry j's result is column slot[j] of
+/// (*products)[octant_j].
+void TranslateByOctant(const std::array<MatX, 8>& ops, const MatX& in,
+                       const std::vector<int>& column, const std::vector<int>& octant,
+                       std::array<MatX, 8>* products, std::vector<int>* slot) {
+  std::array<int, 8> count{};
+  slot->resize(column.size());
+  for (std::size_t j = 0; j < column.size(); ++j)
+    (*slot)[j] = count[static_cast<size_t>(octant[j])]++;
+  std::array<MatX, 8> gathered;
+  for (std::size_t o = 0; o < 8; ++o) gathered[o].resize(in.rows(), count[o]);
+  for (std::size_t j = 0; j < column.size(); ++j)
+    gathered[static_cast<size_t>(octant[j])].col((*slot)[j]) = in.col(column[j]);
+  for (std::size_t o = 0; o < 8; ++o) Gemm(ops[o], false, gathered[o], 1.0, 0.0, &(*products)[o]);
+}
+
 class FmmStokesletSum final : public StokesletSum {
  public:
   explicit FmmStokesletSum(const StokesletSumOptions& options)
@@ -283,36 +301,59 @@ void FmmStokesletSum::Upward() const {
     }
   }
   Gemm(op_->check_to_up, false, check, width, 0.0, &up_[static_cast<size_t>(leaf)]);
+  std::array<MatX, 8> moved;
+  std::vector<int> column, octant, slot;
   for (int l = leaf - 1; l >= 2; --l) {
     const auto& parents = tree_.levels[static_cast<size_t>(l)];
     const auto& children = tree_.levels[static_cast<size_t>(l) + 1];
-    const MatX& child_up = up_[static_cast<size_t>(l) + 1];
+    column.clear();
+    octant.clear();
+    std::vector<int> entry(children.size(), -1);  // child → its entry in column
+    for (std::size_t c = 0; c < children.size(); ++c)
+      if (children[c].has_sources()) {
+        entry[c] = static_cast<int>(column.size());
+        column.push_back(static_cast<int>(c));
+        octant.push_back(static_cast<int>(children[c].code & 7));
+      }
+    TranslateByOctant(op_->m2m, up_[static_cast<size_t>(l) + 1], column, octant, &moved, &slot);
     MatX& parent_up = up_[static_cast<size_t>(l)];
-#pragma omp parallel for schedule(dynamic, 4)
+#pragma omp parallel for schedule(static)
     for (std::size_t b = 0; b < parents.size(); ++b) {
       auto out = parent_up.col(static_cast<Eigen::Index>(b));
       out.setZero();
-      for (int c = parents[b].child_begin; c < parents[b].child_end; ++c)
-        if (children[static_cast<size_t>(c)].has_sources())
-          out.noalias() += op_->m2m[children[static_cast<size_t>(c)].code & 7] * child_up.col(c);
+      for (int c = parents[b].child_begin; c < parents[b].child_end; ++c) {
+        const int j = entry[static_cast<size_t>(c)];  // children in order: as before, per box
+        if (j < 0) continue;
+        const auto k = static_cast<size_t>(j);
+        out += moved[static_cast<size_t>(octant[k])].col(slot[k]);
+      }
     }
   }
 }
 
 // M2L over the V lists and L2L, level by level from the top.
 void FmmStokesletSum::Downward() const {
+  std::array<MatX, 8> moved;
+  std::vector<int> column, octant, slot, box;
   for (int l = 2; l <= tree_.depth; ++l) {
     M2l(l);
     const auto& boxes = tree_.levels[static_cast<size_t>(l)];
     MatX& down = down_[static_cast<size_t>(l)];
     Gemm(op_->check_to_down, false, check_[static_cast<size_t>(l)], 1.0, 0.0, &down);
     if (l == 2) continue;
-    const MatX& parent = down_[static_cast<size_t>(l) - 1];
-#pragma omp parallel for schedule(static)
+    column.clear();
+    octant.clear();
+    box.clear();
     for (std::size_t b = 0; b < boxes.size(); ++b)
-      if (boxes[b].has_targets())
-        down.col(static_cast<Eigen::Index>(b)).noalias() +=
-            op_->l2l[boxes[b].code & 7] * parent.col(boxes[b].parent);
+      if (boxes[b].has_targets()) {
+        box.push_back(static_cast<int>(b));
+        column.push_back(boxes[b].parent);
+        octant.push_back(static_cast<int>(boxes[b].code & 7));
+      }
+    TranslateByOctant(op_->l2l, down_[static_cast<size_t>(l) - 1], column, octant, &moved, &slot);
+#pragma omp parallel for schedule(static)
+    for (std::size_t j = 0; j < box.size(); ++j)
+      down.col(box[j]) += moved[static_cast<size_t>(octant[j])].col(slot[j]);  // one per box
   }
 }
 
