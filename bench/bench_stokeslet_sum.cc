@@ -3,7 +3,8 @@
 // sources, ε = 1.02e-3 m, bases 0.04 m apart). Arguments: number of helices, expansion order p of
 // the FMM (0: the direct sum), at the tolerance that selects it. Counters: the error (the norm of
 // stokeslet_sum.h, against the direct sum, one random g), the pairs summed exactly (near) and by
-// expansions (far), the memory, 3n.
+// expansions (far), the memory, 3n. A third argument, 0, takes the FMM's M2L summed directly
+// instead of by Fourier transforms (the reference, fmm_m2l_fft.h).
 // Run: OMP_NUM_THREADS=1 build/release/bench/bench_stokeslet_sum --benchmark_repetitions=3
 //        --benchmark_report_aggregates_only=true   (and OMP_NUM_THREADS=2)
 #include <benchmark/benchmark.h>
@@ -15,6 +16,8 @@
 #include <random>
 
 #include "common/helix_lattice.h"
+#include "stokesrods/fluid/fmm_m2l_fft.h"
+#include "stokesrods/fluid/fmm_operators.h"
 #include "stokesrods/fluid/mobility_operator.h"
 #include "stokesrods/fluid/stokeslet_sum.h"
 
@@ -30,10 +33,10 @@ Lattice HelixLattice(int helices) {
 }
 
 // The tolerance of each order (fmm_sum.cc); the FMM's own cost model decides whether it is used.
-std::unique_ptr<StokesletSum> MakeSum(int order) {
+std::unique_ptr<StokesletSum> MakeSum(int order, bool m2l_by_fft = true) {
   if (order == 0) return MakeDirectStokesletSum();
   const double tolerance = order == 4 ? 1e-4 : order == 5 ? 2.1e-5 : 1.25e-6;
-  return MakeFastStokesletSum({.tolerance = tolerance});
+  return MakeFastStokesletSum({.tolerance = tolerance, .m2l_by_fft = m2l_by_fft});
 }
 
 Matrix3X RandomStrengths(Eigen::Index n) {
@@ -72,7 +75,7 @@ void BM_StokesletSumBuild(benchmark::State& st) {
 
 void BM_StokesletSumApply(benchmark::State& st) {
   const Lattice c = HelixLattice(static_cast<int>(st.range(0)));
-  auto sum = MakeSum(static_cast<int>(st.range(1)));
+  auto sum = MakeSum(static_cast<int>(st.range(1)), st.range(2) != 0);
   sum->Build(c.sources, c.regularization, c.targets);
   const Matrix3X g = RandomStrengths(c.sources.cols());
   Matrix3X w;
@@ -86,10 +89,55 @@ void BM_StokesletSumApply(benchmark::State& st) {
 
 void Cases(benchmark::internal::Benchmark* b) {
   for (int helices : {10, 20, 50, 100})
-    for (int order : {0, 4, 5, 6}) b->Args({helices, order});
+    for (int order : {0, 4, 5, 6})
+      for (int fft : {1, 0})
+        if (order > 0 || fft == 1) b->Args({helices, order, fft});
 }
 BENCHMARK(BM_StokesletSumBuild)->Apply(Cases)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_StokesletSumApply)->Apply(Cases)->Unit(benchmark::kMillisecond);
+
+// The V-list translations of one level alone: 64 boxes, each taking the first `entries` of the
+// 316 offsets (all: 20 224 M2Ls) from random source boxes. Arguments: order p; 1 by Fourier
+// transforms in single precision (fmm_m2l_fft.h), 0 evaluated directly in single precision
+// (AddM2l); entries per box. Counter: ns per M2L (with one entry per box: the transforms' cost).
+void BM_M2lLevel(benchmark::State& st) {
+  const int order = static_cast<int>(st.range(0));
+  const FmmOperators& op = GetFmmOperators(order, 1e-6);
+  constexpr int kBoxes = 64;
+  std::mt19937 rng(2);
+  std::uniform_int_distribution<int> pick(0, kBoxes - 1);
+  FmmList list;
+  for (int t = 0; t < kBoxes; ++t) {
+    for (int o = 0, taken = 0; o < 343 && taken < st.range(2); ++o)
+      if (std::max({std::abs(o / 49 - 3), std::abs(o / 7 % 7 - 3), std::abs(o % 7 - 3)}) >= 2) {
+        ++taken;
+        list.box.push_back(pick(rng));
+        list.offset.push_back(o);
+      }
+    list.start.push_back(static_cast<int>(list.box.size()));
+  }
+  std::normal_distribution<double> normal;
+  MatX up(3 * op.points, kBoxes);
+  for (Eigen::Index k = 0; k < up.size(); ++k) up.data()[k] = normal(rng);
+  MatX check = MatX::Zero(3 * op.points, kBoxes);
+  M2lFftScratch<float> fft;
+  M2lScratch direct;
+  const M2lSpectra& spectra = GetM2lSpectra(op);
+  for (auto _ : st) {
+    if (st.range(1) != 0) {
+      AddM2lByFft(spectra, list, up, &check, &fft);
+    } else {
+      for (int t = 0; t < kBoxes; ++t)
+        AddM2l(op, list.box.data() + list.start[t], list.offset.data() + list.start[t],
+               list.start[t + 1] - list.start[t], up, true, &direct, check.col(t).data());
+    }
+    benchmark::DoNotOptimize(check.data());
+  }
+  st.counters["ns_per_m2l"] = benchmark::Counter(
+      static_cast<double>(list.box.size()) * 1e-9,
+      benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_M2lLevel)->ArgsProduct({{4, 5, 6}, {1, 0}, {316, 1}})->Unit(benchmark::kMillisecond);
 
 // The matrix-free RSS mobility on helices (65 nodes, r0 = 1 mm) on a lattice 4R apart (helices
 // = 10, 20, 50, 100) or on a ring 3R apart (helices = -10, the bench's ring10), with the near zone

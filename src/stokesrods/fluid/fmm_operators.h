@@ -12,10 +12,11 @@
 // actual coordinates) and is computed once per order and process (GetFmmOperators).
 //
 // M2L, K_v = [S(x_i − y_j)] from the upward equivalent surface of the box at offset v (in box
-// widths, v ∈ {−3..3}³, |v|_∞ ≥ 2: the V list) to the downward check surface, is not stored: it
-// is a sum of n singular Stokeslets at n points, evaluated on the fly by the vectorized kernel of
-// the direct sum (AddM2l), which costs n² kernel evaluations per translation (3136 at p = 4,
-// 0.6 µs in single precision) where the stored dense 3n × 3n matrix cost 9n² multiply–adds read
+// widths, v ∈ {−3..3}³, |v|_∞ ≥ 2: the V list) to the downward check surface, is not stored. The
+// FMM applies it by Fourier transforms (fmm_m2l_fft.h, 9× faster at p = 4); AddM2l here is the
+// reference it is tested against: a sum of n singular Stokeslets at n points, evaluated on the
+// fly by the vectorized kernel of the direct sum, which costs n² kernel evaluations per
+// translation (3136 at p = 4, 0.6 µs in single precision on session 8's host) where the stored dense 3n × 3n matrix cost 9n² multiply–adds read
 // from memory, batched by offset into BLAS products of a few columns (5.8 µs each on the
 // 100-helix lattice, half of it OpenBLAS packing K_v). (Compressing all K_v by one SVD basis, as
 // Fong & Darve do, gave ranks within 10 % of 3n at the tolerances of interest: the surfaces are

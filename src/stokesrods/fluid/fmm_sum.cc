@@ -3,7 +3,8 @@
 //
 // Apply: S2M (the leaf's sources, with their own regularized kernel, evaluated on the upward check
 // surface and fitted by upward equivalent densities), M2M up to level 2, M2L over the V lists of
-// every level (each target box's V list summed as the source boxes' equivalent Stokeslets at its
+// every level (by Fourier transforms, fmm_m2l_fft.h: one transform per box, a product per V-list
+// entry; or, the reference, each entry summed as the source box's equivalent Stokeslets at the
 // check points: AddM2l, fmm_operators.h), L2L down, L2T (the
 // downward equivalent densities evaluated at the targets), and the near field (the 27 neighbouring
 // leaves) summed directly with the regularized kernel by the vectorized loop of the direct sum:
@@ -13,12 +14,12 @@
 //
 // DEPTH. The tree is cut at the depth of least estimated cost (FmmCost: kernel evaluations of the
 // near field, S2M and L2T, n² per M2L, the dense translations per box), and the sum is direct
-// where that cost is not below S·T (unless forced, for tests). Deeper, an M2L (n² = 3136 kernel
-// evaluations at p = 4) costs more than summing two boxes of 30–70 points directly, so the leaf
-// width is chosen finer than a factor 2: the root cube's side is extent × 2^(k/4), k = 0 … 3, by
-// the same cost (fmm_tree.cc). On the 100-helix lattice: the root 1.68 × extent at depth 3
-// (leaves 0.080 m wide), 23 % of the pairs near and 2914 M2Ls, where the root of side extent gave
-// depth 2 (leaves 0.095 m), 35 % near and 1604 M2Ls.
+// where that cost is not below S·T (unless forced, for tests). An M2L by Fourier transforms costs
+// about 345 kernel evaluations at p = 4 (the direct one n² = 3136), and the leaf width is chosen
+// finer than a factor 2: the root cube's side is extent × 2^(k/4), k = 0 … 3, by the same cost
+// (fmm_tree.cc). On the 100-helix lattice: 8.3 M near pairs (10 % of all), where the direct M2L's
+// cost chose 18.9 M (the root 1.68 × extent at depth 3, 2914 M2Ls) and the root of side extent
+// alone 29.0 M.
 //
 // PRECISION. From kSinglePrecisionTolerance (1e-4, stokeslet_sum.h) on, the near field, S2M and
 // M2L run in single precision (float SIMD lanes; the fits, M2M, L2L and L2T stay double): the
@@ -39,6 +40,7 @@
 #include <vector>
 
 #include "stokesrods/common/assert.h"
+#include "stokesrods/fluid/fmm_m2l_fft.h"
 #include "stokesrods/fluid/fmm_operators.h"
 #include "stokesrods/fluid/fmm_tree.h"
 #include "stokesrods/fluid/point_stokeslet.h"
@@ -112,6 +114,9 @@ class FmmStokesletSum final : public StokesletSum {
   std::unique_ptr<StokesletSum> direct_;
   bool use_direct_ = true;
   const FmmOperators* op_ = nullptr;
+  const M2lSpectra* spectra_ = nullptr;  // when options_.m2l_by_fft
+  mutable M2lFftScratch<float> fft_single_;
+  mutable M2lFftScratch<double> fft_double_;
   FmmTree tree_;
   Matrix3X x_;        // targets in tree order
   // S' × 7 sources in tree order (point_stokeslet.h) with the current strengths, each leaf's
@@ -166,12 +171,24 @@ void FmmStokesletSum::Build(const Matrix3X& sources, const VecX& regularization,
     // Costs in kernel evaluations (one pair of the near field): an M2L is n² of them (AddM2l),
     // an entry of the dense per-box translations ≈ 0.05 (BLAS products over all boxes).
     const double entries = 9.0 * n * n;
-    const FmmCost cost{.per_point = n, .per_box = 0.05 * 4.0 * entries, .per_m2l = n * n};
+    FmmCost cost{.per_point = n, .per_box = 0.05 * 4.0 * entries, .per_m2l = n * n};
+    if (options_.m2l_by_fft) {
+      // Measured (bench BM_M2lLevel, single precision, one thread, in near-field pairs of
+      // 0.45 ns): a product 1.66 per frequency of the padded spectrum (155 ns at p = 4, 310 at
+      // 5, 555 at 6); a box's transforms ≈ 2.5 × the 2 p H N (p + N) complex multiply–adds of
+      // one column (3.0, 7.0, 13.4 µs), H = p frequencies along z, N = 2p − 1.
+      const double grid = 2 * order - 1, stride = std::ceil(grid * grid * order / 16.0) * 16.0;
+      cost.per_m2l = 1.66 * stride;
+      cost.per_box += 2.5 * 2.0 * order * order * grid * (order + grid);
+    }
     const double eps_max = regularization.size() > 0 ? regularization.cwiseAbs().maxCoeff() : 0.0;
     const double min_width = eps_max * std::pow(kEpsilonConstant / options_.tolerance, 0.25);
     tree_ = BuildFmmTree(sources, targets, min_width, cost, !options_.choose_by_cost);
     use_direct_ = tree_.depth == 0;
-    if (!use_direct_) op_ = &GetFmmOperators(order, kCutoff);
+    if (!use_direct_) {
+      op_ = &GetFmmOperators(order, kCutoff);
+      spectra_ = options_.m2l_by_fft ? &GetM2lSpectra(*op_) : nullptr;
+    }
   }
   stats_ = StokesletSumStats{};
   if (use_direct_) {
@@ -365,6 +382,13 @@ void FmmStokesletSum::M2l(int level) const {
   const MatX& up = up_[static_cast<size_t>(level)];
   MatX& check = check_[static_cast<size_t>(level)];
   check.setZero();
+  if (spectra_ != nullptr) {
+    if (single_)
+      AddM2lByFft(*spectra_, v, up, &check, &fft_single_);
+    else
+      AddM2lByFft(*spectra_, v, up, &check, &fft_double_);
+    return;
+  }
 #pragma omp parallel
   {
     M2lScratch scratch;

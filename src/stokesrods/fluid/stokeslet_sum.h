@@ -32,6 +32,9 @@ struct StokesletSumOptions {
   bool choose_by_cost = true;
   /// Points per edge of the FMM's surfaces; 0: chosen from the tolerance (fmm_sum.cc).
   int order = 0;
+  /// The FMM's V-list translations by Fourier transforms (fmm_m2l_fft.h); false: each evaluated
+  /// directly as a sum of the source box's equivalent Stokeslets (the reference, for tests).
+  bool m2l_by_fft = true;
 };
 
 /// What a Build produced (for tests and benchmarks).
