@@ -33,66 +33,35 @@ typedef double VecD __attribute__((vector_size(kBlock * sizeof(double))));
 // Built for AVX-512, AVX2 + FMA and baseline x86-64, chosen at run time (as the kernels of
 // stokeslet_sum.cc); the loops over columns vectorize.
 template <class T>
-[[gnu::always_inline]] inline void RealToComplexRows(int J, int K, std::ptrdiff_t len,
-                                                     std::ptrdiff_t in_stride,
-                                                     std::ptrdiff_t out_stride, const T* twr,
-                                                     const T* twi, const T* in, T* out_re,
-                                                     T* out_im) {
+[[gnu::always_inline]] inline void RowsImpl(int J, int K, std::ptrdiff_t len,
+                                            std::ptrdiff_t in_stride, std::ptrdiff_t out_stride,
+                                            const T* twr, const T* twi, const T* in_re,
+                                            const T* in_im, T* out_re, T* out_im) {
   for (int k = 0; k < K; ++k) {
     T* __restrict yr = out_re + k * out_stride;
-    T* __restrict yi = out_im + k * out_stride;
+    T* __restrict yi = out_im == nullptr ? nullptr : out_im + k * out_stride;
     std::fill(yr, yr + len, T(0));
-    std::fill(yi, yi + len, T(0));
-    for (int j = 0; j < J; ++j) {
-      const T cr = twr[k * J + j], ci = twi[k * J + j];
-      const T* __restrict x = in + j * in_stride;
-      #pragma omp simd
-      for (std::ptrdiff_t c = 0; c < len; ++c) {
-        yr[c] += cr * x[c];
-        yi[c] += ci * x[c];
-      }
-    }
-  }
-}
-
-template <class T>
-[[gnu::always_inline]] inline void ComplexRows(int J, int K, std::ptrdiff_t len,
-                                               std::ptrdiff_t in_stride, std::ptrdiff_t out_stride,
-                                               const T* twr, const T* twi, const T* in_re,
-                                               const T* in_im, T* out_re, T* out_im) {
-  for (int k = 0; k < K; ++k) {
-    T* __restrict yr = out_re + k * out_stride;
-    T* __restrict yi = out_im + k * out_stride;
-    std::fill(yr, yr + len, T(0));
-    std::fill(yi, yi + len, T(0));
+    if (yi != nullptr) std::fill(yi, yi + len, T(0));
     for (int j = 0; j < J; ++j) {
       const T cr = twr[k * J + j], ci = twi[k * J + j];
       const T* __restrict xr = in_re + j * in_stride;
-      const T* __restrict xi = in_im + j * in_stride;
-      #pragma omp simd
-      for (std::ptrdiff_t c = 0; c < len; ++c) {
-        yr[c] += cr * xr[c] - ci * xi[c];
-        yi[c] += cr * xi[c] + ci * xr[c];
+      const T* __restrict xi = in_im == nullptr ? nullptr : in_im + j * in_stride;
+      if (xi == nullptr) {  // real input, complex output
+#pragma omp simd
+        for (std::ptrdiff_t c = 0; c < len; ++c) {
+          yr[c] += cr * xr[c];
+          yi[c] += ci * xr[c];
+        }
+      } else if (yi == nullptr) {  // the real part of the output only
+#pragma omp simd
+        for (std::ptrdiff_t c = 0; c < len; ++c) yr[c] += cr * xr[c] - ci * xi[c];
+      } else {
+#pragma omp simd
+        for (std::ptrdiff_t c = 0; c < len; ++c) {
+          yr[c] += cr * xr[c] - ci * xi[c];
+          yi[c] += cr * xi[c] + ci * xr[c];
+        }
       }
-    }
-  }
-}
-
-template <class T>
-[[gnu::always_inline]] inline void ComplexToRealRows(int J, int K, std::ptrdiff_t len,
-                                                     std::ptrdiff_t in_stride,
-                                                     std::ptrdiff_t out_stride, const T* twr,
-                                                     const T* twi, const T* in_re,
-                                                     const T* in_im, T* out) {
-  for (int k = 0; k < K; ++k) {
-    T* __restrict y = out + k * out_stride;
-    std::fill(y, y + len, T(0));
-    for (int j = 0; j < J; ++j) {
-      const T cr = twr[k * J + j], ci = twi[k * J + j];
-      const T* __restrict xr = in_re + j * in_stride;
-      const T* __restrict xi = in_im + j * in_stride;
-      #pragma omp simd
-      for (std::ptrdiff_t c = 0; c < len; ++c) y[c] += cr * xr[c] - ci * xi[c];
     }
   }
 }
@@ -145,20 +114,11 @@ template <class T>
 
 #define SR_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #define SR_INSTANTIATE(T)                                                                       \
-  SR_CLONES void RealToComplex(int J, int K, std::ptrdiff_t len, std::ptrdiff_t in_stride,      \
-                               std::ptrdiff_t out_stride, const T* twr, const T* twi,          \
-                               const T* in, T* out_re, T* out_im) {                            \
-    RealToComplexRows<T>(J, K, len, in_stride, out_stride, twr, twi, in, out_re, out_im);      \
-  }                                                                                             \
-  SR_CLONES void Complex(int J, int K, std::ptrdiff_t len, std::ptrdiff_t in_stride,            \
-                         std::ptrdiff_t out_stride, const T* twr, const T* twi, const T* in_re, \
-                         const T* in_im, T* out_re, T* out_im) {                                \
-    ComplexRows<T>(J, K, len, in_stride, out_stride, twr, twi, in_re, in_im, out_re, out_im);  \
-  }                                                                                             \
-  SR_CLONES void ComplexToReal(int J, int K, std::ptrdiff_t len, std::ptrdiff_t in_stride,      \
-                               std::ptrdiff_t out_stride, const T* twr, const T* twi,          \
-                               const T* in_re, const T* in_im, T* out) {                       \
-    ComplexToRealRows<T>(J, K, len, in_stride, out_stride, twr, twi, in_re, in_im, out);       \
+  /* in_im null: real input; out_im null: the real part of the output only */                  \
+  SR_CLONES void Rows(int J, int K, std::ptrdiff_t len, std::ptrdiff_t in_stride,               \
+                      std::ptrdiff_t out_stride, const T* twr, const T* twi, const T* in_re,    \
+                      const T* in_im, T* out_re, T* out_im) {                                   \
+    RowsImpl<T>(J, K, len, in_stride, out_stride, twr, twi, in_re, in_im, out_re, out_im);     \
   }                                                                                             \
   SR_CLONES void BlockProducts(const T* kernel, const int* bucket, const int* target,         \
                                const int* source, const T* g, T* c) {                           \
@@ -215,17 +175,17 @@ void Forward(int P, int N, std::ptrdiff_t L, const T* in, T* out_re, T* out_im,
   temp2_im->resize(b_size);
   T *ar = temp_re->data(), *ai = temp_im->data(), *br = temp2_re->data(), *bi = temp2_im->data();
   ForSlices(P * P, L, [&](int s, std::ptrdiff_t c, std::ptrdiff_t len) {  // along z
-    RealToComplex(P, H, len, L, L, zr.data(), zi.data(), in + s * P * L + c, ar + s * H * L + c,
-                  ai + s * H * L + c);
+    Rows(P, H, len, L, L, zr.data(), zi.data(), in + s * P * L + c, static_cast<const T*>(nullptr),
+         ar + s * H * L + c, ai + s * H * L + c);
   });
   const std::ptrdiff_t row_y = H * L;
   ForSlices(P, row_y, [&](int s, std::ptrdiff_t c, std::ptrdiff_t len) {  // along y
     const std::ptrdiff_t i = s * P * row_y + c, o = s * N * row_y + c;
-    Complex(P, N, len, row_y, row_y, yr.data(), yi.data(), ar + i, ai + i, br + o, bi + o);
+    Rows(P, N, len, row_y, row_y, yr.data(), yi.data(), ar + i, ai + i, br + o, bi + o);
   });
   const std::ptrdiff_t row_x = N * H * L;
   ForSlices(1, row_x, [&](int, std::ptrdiff_t c, std::ptrdiff_t len) {  // along x
-    Complex(P, N, len, row_x, row_x, yr.data(), yi.data(), br + c, bi + c, out_re + c, out_im + c);
+    Rows(P, N, len, row_x, row_x, yr.data(), yi.data(), br + c, bi + c, out_re + c, out_im + c);
   });
 }
 
@@ -247,16 +207,16 @@ void Inverse(int p, int N, std::ptrdiff_t L, const T* in_re, const T* in_im, T* 
   T *br = temp_re->data(), *bi = temp_im->data(), *ar = temp2_re->data(), *ai = temp2_im->data();
   const std::ptrdiff_t row_x = N * H * L;
   ForSlices(1, row_x, [&](int, std::ptrdiff_t c, std::ptrdiff_t len) {  // along x
-    Complex(N, p, len, row_x, row_x, xr.data(), xi.data(), in_re + c, in_im + c, br + c, bi + c);
+    Rows(N, p, len, row_x, row_x, xr.data(), xi.data(), in_re + c, in_im + c, br + c, bi + c);
   });
   const std::ptrdiff_t row_y = H * L;
   ForSlices(p, row_y, [&](int s, std::ptrdiff_t c, std::ptrdiff_t len) {  // along y
     const std::ptrdiff_t i = s * N * row_y + c, o = s * p * row_y + c;
-    Complex(N, p, len, row_y, row_y, xr.data(), xi.data(), br + i, bi + i, ar + o, ai + o);
+    Rows(N, p, len, row_y, row_y, xr.data(), xi.data(), br + i, bi + i, ar + o, ai + o);
   });
   ForSlices(p * p, L, [&](int s, std::ptrdiff_t c, std::ptrdiff_t len) {  // along z, real
-    ComplexToReal(H, p, len, L, L, zr.data(), zi.data(), ar + s * H * L + c, ai + s * H * L + c,
-                  out + s * p * L + c);
+    Rows(H, p, len, L, L, zr.data(), zi.data(), ar + s * H * L + c, ai + s * H * L + c,
+         out + s * p * L + c, static_cast<T*>(nullptr));
   });
 }
 
