@@ -11,6 +11,10 @@
 namespace stokesrods {
 namespace {
 
+/// A tree is built only where its estimated cost is below this share of the direct sum's pairs
+/// (see BuildFmmTree).
+constexpr double kTreePays = 0.65;
+
 constexpr int kMaxLevel = 20;  // Morton codes of 3 × 20 bits
 
 std::uint64_t Spread(std::uint64_t v) {  // bits b → 3b
@@ -310,10 +314,14 @@ FmmTree BuildFmmTree(const Matrix3X& sources, const Matrix3X& targets, double mi
   tree.width = extent * (1.0 + 1e-9);
   const double pairs = static_cast<double>(sources.cols()) * static_cast<double>(targets.cols());
   // Whether the tree pays is decided on the root of side `extent` alone, as before the choice of
-  // widths below: near the break-even the estimate is optimistic (10 helices, 1280 × 650 points:
-  // a wider root estimated at 0.98 of the direct sum's pairs ran 1.16× slower than it).
+  // widths below, and only below kTreePays of the direct sum's pairs: the estimate is optimistic
+  // (10 helices, 1280 × 650 points: a wider root estimated at 0.98 of the pairs ran 1.16× slower
+  // than the direct sum; with the M2L by FFT, Apply ran 1.23, 1.42 and 1.50× its estimate on 20,
+  // 50 and 100 helices, and the 20-helix step, its tree estimated at 0.73, 1.10× slower than
+  // with the direct sum: the tree's Build is not in the estimate).
+  const double direct_cost = kTreePays * pairs;
   LeastCostDepth least = LeastCost(sources, targets, tree.corner, tree.width, min_leaf_width, cost);
-  if (!force_tree && least.complete && least.cost >= pairs) return FmmTree{};
+  if (!force_tree && least.complete && least.cost >= direct_cost) return FmmTree{};
   // The root's side, extent × 2^(k/4), k = 0 … 3: leaves of any width within a factor 2^(1/8)
   // (a uniform tree offers only extent / 2^depth), chosen by the estimated cost. The levels below
   // the estimate's depth are not built (when it counted every level it needed).
@@ -350,7 +358,7 @@ FmmTree BuildFmmTree(const Matrix3X& sources, const Matrix3X& targets, double mi
     // The cost is convex in the depth: stop once it has clearly turned.
     if (total > 2.0 * best || tree.levels.back().size() >= static_cast<size_t>(sources.cols() + targets.cols())) break;
   }
-  if (tree.depth == 0 || (!force_tree && best >= pairs)) return FmmTree{};
+  if (tree.depth == 0 || (!force_tree && best >= direct_cost)) return FmmTree{};
   tree.levels.resize(static_cast<size_t>(tree.depth) + 1);
   tree.v_lists.resize(static_cast<size_t>(tree.depth) + 1);
   tree.near = MakeNearList(tree.levels.back(), tree.depth, &tree.near_pairs);
