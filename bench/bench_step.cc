@@ -152,10 +152,11 @@ void BM_MobilityProduct(benchmark::State& st, bool single) {
 BENCHMARK_CAPTURE(BM_MobilityProduct, double, false)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_MobilityProduct, single_double_sums, true)->Unit(benchmark::kMicrosecond);
 
-// The preconditioner's solve of one vector with the float LU of Fig. 1's C (3M = 390): getrs
-// against the blocked substitution of solver/lu_solve_avx512.cc.
+// The preconditioner's solve of one vector with a float LU of size n: Fig. 1's C (3M = 390) and
+// the coarse level's E on 100 helices (2400; from 1024 on, the panels over the OpenMP threads):
+// getrs against the blocked substitution of solver/lu_solve_avx512.cc.
 void BM_FloatLuSolve(benchmark::State& st, bool lapack) {
-  const int n = 390;
+  const int n = static_cast<int>(st.range(0));
   const Eigen::MatrixXf a = Eigen::MatrixXf::Random(n, n) + n * Eigen::MatrixXf::Identity(n, n);
   DenseLu<float> lu;
   lu.Compute(a);
@@ -166,8 +167,8 @@ void BM_FloatLuSolve(benchmark::State& st, bool lapack) {
     benchmark::DoNotOptimize(x.data());
   }
 }
-BENCHMARK_CAPTURE(BM_FloatLuSolve, getrs, true)->Unit(benchmark::kMicrosecond);
-BENCHMARK_CAPTURE(BM_FloatLuSolve, blocked, false)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_FloatLuSolve, getrs, true)->Arg(390)->Arg(2400)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_FloatLuSolve, blocked, false)->Arg(390)->Arg(2400)->Unit(benchmark::kMicrosecond);
 
 // The same with LAPACK (dgbtrf, then dgbtrs for one right-hand side), same storage.
 void BM_BandedLapack(benchmark::State& st, bool solve) {

@@ -3,6 +3,9 @@
 #include "stokesrods/solver/dense_lu.h"
 
 #include <gtest/gtest.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include <algorithm>
 #include <random>
@@ -48,13 +51,14 @@ TEST(DenseLu, SolvesLikeEigensPartialPivLu) {
 }
 
 // The single-precision solve of one vector on AVX-512 (blocked substitution) against getrs, on
-// sizes around its blocks of 32 columns and 64 rows: on random matrices the same residuals; on
+// sizes around its blocks of 32 columns and 64 rows, and from 1024 on (the panels over the OpenMP
+// threads, blocks of 128 columns): on random matrices the same residuals; on
 // well-conditioned ones (diagonally dominant, rows shuffled so that every column pivots) the same
 // solution to float rounding.
 TEST(DenseLu, TheBlockedSingleSolveMatchesGetrs) {
   if (!HasLuSolveAvx512()) GTEST_SKIP() << "no AVX-512 here: getrs is the only path";
   std::mt19937 rng(9);
-  for (const int n : {1, 5, 31, 32, 33, 63, 64, 65, 100, 390}) {
+  for (const int n : {1, 5, 31, 32, 33, 63, 64, 65, 100, 390, 1023, 1024, 1100, 2400}) {
     Eigen::MatrixXf random = RandomMatrix<float>(n, &rng);
     Eigen::MatrixXf dominant = random + static_cast<float>(2 * n) * Eigen::MatrixXf::Identity(n, n);
     Eigen::PermutationMatrix<Eigen::Dynamic> shuffle(n);
@@ -77,6 +81,29 @@ TEST(DenseLu, TheBlockedSingleSolveMatchesGetrs) {
       }
     }
   }
+}
+
+// From n = 1024 the solve's panels run over the OpenMP threads: the same result on any number.
+TEST(DenseLu, TheBlockedSingleSolveDoesNotDependOnTheThreadCount) {
+#ifdef _OPENMP
+  if (!HasLuSolveAvx512()) GTEST_SKIP() << "no AVX-512 here: getrs is the only path";
+  std::mt19937 rng(4);
+  const int n = 1500;
+  const Eigen::MatrixXf a = RandomMatrix<float>(n, &rng);
+  const Eigen::VectorXf b = RandomMatrix<float>(n, &rng).col(0);
+  DenseLu<float> lu;
+  ASSERT_TRUE(lu.Compute(a));
+  Eigen::VectorXf x[2] = {b, b};
+  const int saved = omp_get_max_threads();
+  for (int threads = 1; threads <= 2; ++threads) {
+    omp_set_num_threads(threads);
+    lu.Solve(&x[threads - 1]);
+  }
+  omp_set_num_threads(saved);
+  EXPECT_TRUE(x[0] == x[1]);
+#else
+  GTEST_SKIP() << "built without OpenMP";
+#endif
 }
 
 TEST(DenseLu, ReportsASingularMatrix) {

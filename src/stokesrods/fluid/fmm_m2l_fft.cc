@@ -237,6 +237,10 @@ std::unique_ptr<M2lSpectra> MakeSpectra(const FmmOperators& op) {
     }
     s->surface_cell[static_cast<size_t>(j)] = cell;
   }
+  std::vector<bool> on_surface(static_cast<size_t>(p) * p * p, false);
+  for (const int cell : s->surface_cell) on_surface[static_cast<size_t>(cell)] = true;
+  for (int cell = 0; cell < p * p * p; ++cell)
+    if (!on_surface[static_cast<size_t>(cell)]) s->interior_cell.push_back(cell);
   // T_v at the N³ cells of the periodic grid, every offset and component as a column.
   const double eta = 2.0 * kFmmInnerRadius / (p - 1);
   const std::ptrdiff_t L = kOffsets * kComponents;
@@ -303,12 +307,16 @@ void AddM2lByFft(const M2lSpectra& spectra, const FmmList& v_list, const MatX& u
   if (B == 0 || v_list.box.empty()) return;
   const std::ptrdiff_t L = 3 * B;
   // The upward densities on the lattice (the cube's inside zero), column d B + b.
-  scratch->grid.assign(static_cast<size_t>(p) * p * p * L, T(0));
-  for (Eigen::Index b = 0; b < B; ++b)
-    for (Eigen::Index j = 0; j < n; ++j)
-      for (int d = 0; d < 3; ++d)
-        scratch->grid[static_cast<size_t>(spectra.surface_cell[static_cast<size_t>(j)] * L + d * B + b)] =
-            static_cast<T>(up(3 * j + d, b));
+  const auto cells = static_cast<std::ptrdiff_t>(p) * p * p;
+  scratch->grid.resize(static_cast<size_t>(cells * L));
+  for (const int cell : spectra.interior_cell)
+    std::fill_n(scratch->grid.data() + cell * L, L, T(0));
+#pragma omp parallel for schedule(static)
+  for (Eigen::Index j = 0; j < n; ++j)
+    for (int d = 0; d < 3; ++d) {
+      T* row = scratch->grid.data() + spectra.surface_cell[static_cast<size_t>(j)] * L + d * B;
+      for (Eigen::Index b = 0; b < B; ++b) row[b] = static_cast<T>(up(3 * j + d, b));
+    }
   const auto f_size = static_cast<size_t>(F) * L;
   scratch->spectrum_re.resize(f_size);
   scratch->spectrum_im.resize(f_size);
@@ -318,10 +326,12 @@ void AddM2lByFft(const M2lSpectra& spectra, const FmmList& v_list, const MatX& u
   // Block-major spectra (BlockProducts): g[block][box][component's re, im][kBlock].
   const int blocks = static_cast<int>(stride / kBlock);
   const std::ptrdiff_t per_block = B * 6 * kBlock;
-  scratch->boxes.assign(static_cast<size_t>(blocks * per_block), T(0));
-  scratch->sums.assign(static_cast<size_t>(blocks * per_block), T(0));
-  // (block, box, component, lane) ↔ spectrum_*[f L + d B + b], f = block kBlock + lane < F.
+  scratch->boxes.resize(static_cast<size_t>(blocks * per_block));
+  scratch->sums.resize(static_cast<size_t>(blocks * per_block));
+  // (block, box, component, lane) ↔ spectrum_*[f L + d B + b], f = block kBlock + lane < F; the
+  // lanes past F are zero in the blocks.
   auto transpose = [&](bool to_blocks, T* blocked) {
+#pragma omp parallel for schedule(static)
     for (int block = 0; block < blocks; ++block)
       for (Eigen::Index b = 0; b < B; ++b)
         for (int d = 0; d < 3; ++d) {
@@ -339,6 +349,10 @@ void AddM2lByFft(const M2lSpectra& spectra, const FmmList& v_list, const MatX& u
               spectrum_re[lane * L] = re[lane];
               spectrum_im[lane * L] = im[lane];
             }
+          }
+          if (to_blocks) {
+            std::fill(re + lanes, re + kBlock, T(0));
+            std::fill(im + lanes, im + kBlock, T(0));
           }
         }
   };
@@ -364,14 +378,18 @@ void AddM2lByFft(const M2lSpectra& spectra, const FmmList& v_list, const MatX& u
   // box's sum in the order (offset, list position) on any number of threads).
   const T* kernel = spectra_values<T>(spectra);
 #pragma omp parallel for schedule(dynamic, 1)
-  for (int block = 0; block < blocks; ++block)
+  for (int block = 0; block < blocks; ++block) {
+    T* sums = scratch->sums.data() + block * per_block;
+    std::fill_n(sums, per_block, T(0));
     BlockProducts(kernel + static_cast<std::ptrdiff_t>(block) * kOffsets * 12 * kBlock,
                   scratch->bucket.data(), scratch->target.data(), scratch->source.data(),
-                  scratch->boxes.data() + block * per_block, scratch->sums.data() + block * per_block);
+                  scratch->boxes.data() + block * per_block, sums);
+  }
   transpose(false, scratch->sums.data());
   Inverse<T>(p, N, L, scratch->spectrum_re.data(), scratch->spectrum_im.data(),
              scratch->grid.data(), &scratch->temp_re, &scratch->temp_im, &scratch->temp2_re,
              &scratch->temp2_im);
+#pragma omp parallel for schedule(static)
   for (Eigen::Index b = 0; b < B; ++b)
     for (Eigen::Index j = 0; j < n; ++j)
       for (int d = 0; d < 3; ++d)

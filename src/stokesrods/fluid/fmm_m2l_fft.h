@@ -38,6 +38,7 @@ struct M2lSpectra {
   std::vector<double> values;        ///< stride × 343 × 12
   std::vector<float> values_single;  ///< the same in single precision
   std::vector<int> surface_cell;     ///< surface point j → its lattice cell (a_x p + a_y) p + a_z
+  std::vector<int> interior_cell;    ///< the (p − 2)³ cells inside the surface
 };
 
 /// The spectra of the operators' order (computed on first use, then cached with them).
