@@ -99,6 +99,38 @@ void Cases(benchmark::internal::Benchmark* b) {
 BENCHMARK(BM_StokesletSumBuild)->Apply(Cases)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_StokesletSumApply)->Apply(Cases)->Unit(benchmark::kMillisecond);
 
+// The coarse level's sum of the preconditioner (sim/coarse_level.h): 8 chunks of consecutive
+// nodes per helix, each a point Stokeslet at its centroid, summed at all nodes at tolerance 1e-3.
+// Arguments: helices; 1 the fast sum (its cost model decides), 0 the direct sum in single
+// precision.
+void BM_CentroidSum(benchmark::State& st) {
+  const Lattice c = HelixLattice(static_cast<int>(st.range(0)));
+  constexpr int kNodes = 65, kChunks = 8;
+  const Eigen::Index helices = c.targets.cols() / kNodes;
+  Matrix3X centroids(3, helices * kChunks);
+  for (Eigen::Index h = 0; h < helices; ++h)
+    for (int a = 0; a < kChunks; ++a) {
+      const int begin = a * kNodes / kChunks, end = (a + 1) * kNodes / kChunks;
+      centroids.col(h * kChunks + a) =
+          c.targets.middleCols(h * kNodes + begin, end - begin).rowwise().mean();
+    }
+  const VecX eps = VecX::Constant(centroids.cols(), 1.02e-3);
+  auto sum = st.range(1) != 0 ? MakeFastStokesletSum({.tolerance = 1e-3})
+                              : MakeDirectStokesletSum(true);
+  sum->Build(centroids, eps, c.targets);
+  const Matrix3X g = RandomStrengths(centroids.cols());
+  Matrix3X w;
+  for (auto _ : st) {
+    sum->Apply(g, &w);
+    benchmark::DoNotOptimize(w.data());
+  }
+  const StokesletSumStats stats = sum->Stats();
+  st.counters["cost_ratio"] = stats.cost / (static_cast<double>(centroids.cols()) *
+                                            static_cast<double>(c.targets.cols()));
+  st.counters["near_pairs"] = static_cast<double>(stats.near_pairs);
+}
+BENCHMARK(BM_CentroidSum)->ArgsProduct({{20, 50, 100}, {1, 0}})->Unit(benchmark::kMillisecond);
+
 // The V-list translations of one level alone: 64 boxes, each taking the first `entries` of the
 // 316 offsets (all: 20 224 M2Ls) from random source boxes. Arguments: order p; 1 by Fourier
 // transforms in single precision (fmm_m2l_fft.h), 0 evaluated directly in single precision

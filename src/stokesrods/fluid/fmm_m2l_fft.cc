@@ -158,8 +158,16 @@ void ForSlices(int slices, std::ptrdiff_t len, const F& body) {
   }
 }
 
+/// v's first n elements to write into: it grows when too short and never shrinks, so that the
+/// levels of one Apply, of different sizes, do not fill their buffers with zeros every time.
+template <class T>
+T* Grow(std::vector<T>* v, std::size_t n) {
+  if (v->size() < n) v->resize(n);
+  return v->data();
+}
+
 /// out (re, im: N × N × (N+1)/2 × L) = the transform of in (P × P × P × L, real), the batch of L
-/// columns innermost; `temp_*` are resized as needed.
+/// columns innermost; `temp_*` grow as needed (Grow).
 template <class T>
 void Forward(int P, int N, std::ptrdiff_t L, const T* in, T* out_re, T* out_im,
              std::vector<T>* temp_re, std::vector<T>* temp_im, std::vector<T>* temp2_re,
@@ -169,10 +177,10 @@ void Forward(int P, int N, std::ptrdiff_t L, const T* in, T* out_re, T* out_im,
   Twiddles<T>(H, P, N, -1.0, false, &zr, &zi);
   Twiddles<T>(N, P, N, -1.0, false, &yr, &yi);
   const auto a_size = static_cast<size_t>(P) * P * H * L, b_size = static_cast<size_t>(P) * N * H * L;
-  temp_re->resize(a_size);
-  temp_im->resize(a_size);
-  temp2_re->resize(b_size);
-  temp2_im->resize(b_size);
+  Grow(temp_re, a_size);
+  Grow(temp_im, a_size);
+  Grow(temp2_re, b_size);
+  Grow(temp2_im, b_size);
   T *ar = temp_re->data(), *ai = temp_im->data(), *br = temp2_re->data(), *bi = temp2_im->data();
   ForSlices(P * P, L, [&](int s, std::ptrdiff_t c, std::ptrdiff_t len) {  // along z
     Rows(P, H, len, L, L, zr.data(), zi.data(), in + s * P * L + c, static_cast<const T*>(nullptr),
@@ -200,10 +208,10 @@ void Inverse(int p, int N, std::ptrdiff_t L, const T* in_re, const T* in_im, T* 
   Twiddles<T>(p, N, N, 1.0, false, &xr, &xi);
   Twiddles<T>(p, H, N, 1.0, true, &zr, &zi);
   const auto b_size = static_cast<size_t>(p) * N * H * L, a_size = static_cast<size_t>(p) * p * H * L;
-  temp_re->resize(b_size);
-  temp_im->resize(b_size);
-  temp2_re->resize(a_size);
-  temp2_im->resize(a_size);
+  Grow(temp_re, b_size);
+  Grow(temp_im, b_size);
+  Grow(temp2_re, a_size);
+  Grow(temp2_im, a_size);
   T *br = temp_re->data(), *bi = temp_im->data(), *ar = temp2_re->data(), *ai = temp2_im->data();
   const std::ptrdiff_t row_x = N * H * L;
   ForSlices(1, row_x, [&](int, std::ptrdiff_t c, std::ptrdiff_t len) {  // along x
@@ -308,7 +316,7 @@ void AddM2lByFft(const M2lSpectra& spectra, const FmmList& v_list, const MatX& u
   const std::ptrdiff_t L = 3 * B;
   // The upward densities on the lattice (the cube's inside zero), column d B + b.
   const auto cells = static_cast<std::ptrdiff_t>(p) * p * p;
-  scratch->grid.resize(static_cast<size_t>(cells * L));
+  Grow(&scratch->grid, static_cast<size_t>(cells * L));
   for (const int cell : spectra.interior_cell)
     std::fill_n(scratch->grid.data() + cell * L, L, T(0));
 #pragma omp parallel for schedule(static)
@@ -318,16 +326,16 @@ void AddM2lByFft(const M2lSpectra& spectra, const FmmList& v_list, const MatX& u
       for (Eigen::Index b = 0; b < B; ++b) row[b] = static_cast<T>(up(3 * j + d, b));
     }
   const auto f_size = static_cast<size_t>(F) * L;
-  scratch->spectrum_re.resize(f_size);
-  scratch->spectrum_im.resize(f_size);
+  Grow(&scratch->spectrum_re, f_size);
+  Grow(&scratch->spectrum_im, f_size);
   Forward<T>(p, N, L, scratch->grid.data(), scratch->spectrum_re.data(),
              scratch->spectrum_im.data(), &scratch->temp_re, &scratch->temp_im, &scratch->temp2_re,
              &scratch->temp2_im);
   // Block-major spectra (BlockProducts): g[block][box][component's re, im][kBlock].
   const int blocks = static_cast<int>(stride / kBlock);
   const std::ptrdiff_t per_block = B * 6 * kBlock;
-  scratch->boxes.resize(static_cast<size_t>(blocks * per_block));
-  scratch->sums.resize(static_cast<size_t>(blocks * per_block));
+  Grow(&scratch->boxes, static_cast<size_t>(blocks * per_block));
+  Grow(&scratch->sums, static_cast<size_t>(blocks * per_block));
   // (block, box, component, lane) ↔ spectrum_*[f L + d B + b], f = block kBlock + lane < F; the
   // lanes past F are zero in the blocks.
   auto transpose = [&](bool to_blocks, T* blocked) {
@@ -363,8 +371,8 @@ void AddM2lByFft(const M2lSpectra& spectra, const FmmList& v_list, const MatX& u
   for (const int o : v_list.offset) ++scratch->bucket[static_cast<size_t>(o) + 1];
   for (int o = 0; o < kOffsets; ++o)
     scratch->bucket[static_cast<size_t>(o) + 1] += scratch->bucket[static_cast<size_t>(o)];
-  scratch->target.resize(entries);
-  scratch->source.resize(entries);
+  Grow(&scratch->target, entries);
+  Grow(&scratch->source, entries);
   {
     std::vector<int> next(scratch->bucket.begin(), scratch->bucket.end() - 1);
     for (Eigen::Index t = 0; t < B; ++t)

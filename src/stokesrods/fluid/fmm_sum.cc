@@ -151,6 +151,9 @@ class FmmStokesletSum final : public StokesletSum {
 constexpr double kCutoff = 1e-6;
 constexpr std::array<double, 3> kOrderError = {6.4e-5, 1.4e-5, 8.1e-7};  // p = 4, 5, 6
 
+/// The far part's cost in a whole Apply over its estimate from BM_M2lLevel's constants.
+constexpr double kFarCostInApply = 1.5;
+
 /// p for the options; 0 when no order reaches the tolerance.
 int OrderFor(const StokesletSumOptions& options) {
   if (options.order > 0) return options.order;
@@ -181,6 +184,12 @@ void FmmStokesletSum::Build(const Matrix3X& sources, const VecX& regularization,
       cost.per_m2l = 1.66 * stride;
       cost.per_box += 2.5 * 2.0 * order * order * grid * (order + grid);
     }
+    // Those constants are measured on one level of 64 boxes that stays in cache; in a whole
+    // Apply the far part costs more (the 100-helix lattice ran 1.5× its estimate, at session
+    // 11's constants): both ×1.5, which there takes the tree with 12.9 M near pairs instead of
+    // 8.3 M, and a 4–5 % faster Apply (docs/performance.md, session 12).
+    cost.per_m2l *= kFarCostInApply;
+    cost.per_box *= kFarCostInApply;
     const double eps_max = regularization.size() > 0 ? regularization.cwiseAbs().maxCoeff() : 0.0;
     const double min_width = eps_max * std::pow(kEpsilonConstant / options_.tolerance, 0.25);
     tree_ = BuildFmmTree(sources, targets, min_width, cost, !options_.choose_by_cost);
@@ -412,27 +421,41 @@ void FmmStokesletSum::Leaves(Matrix3X* w) const {
   w->setZero(3, x_.cols());
 #pragma omp parallel
   {
-    MatX surface(n, 7);  // the downward equivalent densities as sources, ε = 0
+    // The downward equivalent densities as sources, ε = 0 (L2T), in the sum's precision: in
+    // single precision relative to the box's centre (rounding 1e-7 of the box, not of the cloud).
+    MatX surface(n, 7);
     surface.col(3).setZero();
+    Eigen::MatrixXf surface_f(single_ ? n : 0, 7);
+    if (single_) {
+      surface_f.leftCols<3>() = (kFmmOuterRadius * width * op_->surface).transpose().cast<float>();
+      surface_f.col(3).setZero();
+    }
 #pragma omp for schedule(dynamic, 4)
     for (std::size_t b = 0; b < boxes.size(); ++b) {
       const FmmBox& box = boxes[b];
       if (!box.has_targets()) continue;
       const Vec3 centre = tree_.BoxCentre(leaf, box.code);
-      surface.leftCols<3>() =
-          ((kFmmOuterRadius * width * op_->surface).colwise() + centre).transpose();
-      surface.rightCols<3>() =
-          Eigen::Map<const Matrix3X>(down_[static_cast<size_t>(leaf)].col(static_cast<Eigen::Index>(b)).data(), 3, n)
-              .transpose();
+      const auto down =
+          Eigen::Map<const Matrix3X>(down_[static_cast<size_t>(leaf)].col(static_cast<Eigen::Index>(b)).data(), 3, n);
+      if (single_) {
+        surface_f.rightCols<3>() = down.transpose().cast<float>();
+      } else {
+        surface.leftCols<3>() =
+            ((kFmmOuterRadius * width * op_->surface).colwise() + centre).transpose();
+        surface.rightCols<3>() = down.transpose();
+      }
       const SourceColumns far = Columns(surface);
+      const SourceColumnsF far_f = single_ ? ColumnsF(surface_f) : SourceColumnsF{};
       for (int t = box.tgt_begin; t < box.tgt_end; ++t) {
         double* out = w->col(t).data();
-        AddPointSum(far, 0, n, x_.col(t).data(), out);
         const SourceRange* near = near_ranges_.data() + near_range_start_[b];
         const int count = near_range_start_[b + 1] - near_range_start_[b];
         if (single_) {
+          const Eigen::Vector3f local = (x_.col(t) - centre).cast<float>();
+          AddPointSumSingle(far_f, 0, n, local.data(), out);
           AddPointSumBlocks(columns_f, near, count, x_f_.col(t).data(), out);
         } else {
+          AddPointSum(far, 0, n, x_.col(t).data(), out);
           for (int r = 0; r < count; ++r)
             AddPointSum(columns, near[r].begin, near[r].end, x_.col(t).data(), out);
         }

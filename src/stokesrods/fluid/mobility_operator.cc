@@ -313,22 +313,40 @@ void MatrixFreeRssMobility::FindNearBlocks(const Matrix3X& targets, NearBlocks* 
   const int m = static_cast<int>(targets.cols());
   std::vector<std::vector<std::pair<int, Mat3>>>& per_target = per_target_;
   per_target.resize(static_cast<size_t>(m));
+  // Targets by blocks of kTargetBlock consecutive columns (a rod's nodes: close together): the
+  // chunks near a block's bounding box are found once for the block, so that each target tests
+  // only those (a test per target and rod was O(targets × rods): 5 % of the step at 100 helices).
+  constexpr int kTargetBlock = 16;
+  const int num_blocks = (m + kTargetBlock - 1) / kTargetBlock;
 #pragma omp parallel
   {
     std::vector<int> near;          // global segment indices near the target, in rod order
+    std::vector<int> block_chunks;  // the chunks near the block's box, in rod order
     std::vector<unsigned char> flags;
     std::vector<double> table;
     std::vector<char> is_near;
-#pragma omp for schedule(dynamic, 16)
-    for (int t = 0; t < m; ++t) {
-      const Vec3 p = targets.col(t);
-      near.clear();
-      auto outside = [&](std::size_t b) { return boxes[b].exteriorDistance(p) >= box_reach[b]; };
+#pragma omp for schedule(dynamic, 1)
+    for (int tb = 0; tb < num_blocks; ++tb) {
+      const int t_begin = tb * kTargetBlock, t_end = std::min(m, t_begin + kTargetBlock);
+      Eigen::AlignedBox3d block_box;
+      for (int t = t_begin; t < t_end; ++t) block_box.extend(Vec3(targets.col(t)));
+      block_chunks.clear();
       for (int r = 0; r < num_rods(); ++r) {
-        if (outside(static_cast<size_t>(r))) continue;
+        if (boxes[static_cast<size_t>(r)].exteriorDistance(block_box) >=
+            box_reach[static_cast<size_t>(r)])
+          continue;
         for (int c = rod_first_chunk[static_cast<size_t>(r)];
              c < rod_first_chunk[static_cast<size_t>(r) + 1]; ++c) {
-          if (outside(static_cast<size_t>(num_rods() + c))) continue;
+          const auto b = static_cast<size_t>(num_rods() + c);
+          if (boxes[b].exteriorDistance(block_box) < box_reach[b]) block_chunks.push_back(c);
+        }
+      }
+      for (int t = t_begin; t < t_end; ++t) {
+        const Vec3 p = targets.col(t);
+        near.clear();
+        for (const int c : block_chunks) {
+          const auto b = static_cast<size_t>(num_rods() + c);
+          if (boxes[b].exteriorDistance(p) >= box_reach[b]) continue;
           const int first = chunk_first_segment[static_cast<size_t>(c)];
           const int count = chunk_first_segment[static_cast<size_t>(c) + 1] - first;
           flags.resize(static_cast<size_t>(count));
@@ -337,38 +355,38 @@ void MatrixFreeRssMobility::FindNearBlocks(const Matrix3X& targets, NearBlocks* 
           for (int k = 0; k < count; ++k)
             if (flags[static_cast<size_t>(k)]) near.push_back(first + k);
         }
-      }
-      std::vector<std::pair<int, Mat3>>& blocks = per_target[static_cast<size_t>(t)];
-      blocks.clear();
-      for (std::size_t i = 0; i < near.size();) {  // one rod at a time (segments in rod order)
-        const int rod = segments_[static_cast<size_t>(near[i])].rod;
-        const int rod_first_segment = node_offset(rod) - rod;  // N_k − 1 segments per rod
-        std::size_t end = i;
-        while (end < near.size() && segments_[static_cast<size_t>(near[end])].rod == rod) ++end;
-        const int lo = near[i] - rod_first_segment, hi = near[end - 1] - rod_first_segment;
-        const int count = hi - lo + 1;
-        table.resize(static_cast<size_t>(12 * count));
-        is_near.assign(static_cast<size_t>(count), 0);
-        for (std::size_t k = i; k < end; ++k)
-          is_near[static_cast<size_t>(near[k] - rod_first_segment - lo)] = 1;
-        const RssRowKernel& kernel = kernels[static_cast<size_t>(rod)];
-        kernel.Row(p, lo, count, table.data());
-        kernel.SubtractRule(p, lo, count, table.data());
-        // Node k (local) collects A_a of segment k and A_b of segment k − 1, near ones only.
-        for (int k = lo; k <= hi + 1; ++k) {
-          const bool a_near = k <= hi && is_near[static_cast<size_t>(k - lo)];
-          const bool b_near = k > lo && is_near[static_cast<size_t>(k - 1 - lo)];
-          if (!a_near && !b_near) continue;
-          double e[6];
-          for (int c = 0; c < 6; ++c)
-            e[c] = (a_near ? table[static_cast<size_t>(c * count + k - lo)] : 0.0) +
-                   (b_near ? table[static_cast<size_t>((6 + c) * count + k - 1 - lo)] : 0.0);
-          const int node = node_offset(rod) + k;
-          Mat3 block;
-          block << e[0], e[1], e[2], e[1], e[3], e[4], e[2], e[4], e[5];
-          blocks.emplace_back(node, (scale * inverse_voronoi_(node)) * block);
+        std::vector<std::pair<int, Mat3>>& blocks = per_target[static_cast<size_t>(t)];
+        blocks.clear();
+        for (std::size_t i = 0; i < near.size();) {  // one rod at a time (segments in rod order)
+          const int rod = segments_[static_cast<size_t>(near[i])].rod;
+          const int rod_first_segment = node_offset(rod) - rod;  // N_k − 1 segments per rod
+          std::size_t end = i;
+          while (end < near.size() && segments_[static_cast<size_t>(near[end])].rod == rod) ++end;
+          const int lo = near[i] - rod_first_segment, hi = near[end - 1] - rod_first_segment;
+          const int count = hi - lo + 1;
+          table.resize(static_cast<size_t>(12 * count));
+          is_near.assign(static_cast<size_t>(count), 0);
+          for (std::size_t k = i; k < end; ++k)
+            is_near[static_cast<size_t>(near[k] - rod_first_segment - lo)] = 1;
+          const RssRowKernel& kernel = kernels[static_cast<size_t>(rod)];
+          kernel.Row(p, lo, count, table.data());
+          kernel.SubtractRule(p, lo, count, table.data());
+          // Node k (local) collects A_a of segment k and A_b of segment k − 1, near ones only.
+          for (int k = lo; k <= hi + 1; ++k) {
+            const bool a_near = k <= hi && is_near[static_cast<size_t>(k - lo)];
+            const bool b_near = k > lo && is_near[static_cast<size_t>(k - 1 - lo)];
+            if (!a_near && !b_near) continue;
+            double e[6];
+            for (int c = 0; c < 6; ++c)
+              e[c] = (a_near ? table[static_cast<size_t>(c * count + k - lo)] : 0.0) +
+                     (b_near ? table[static_cast<size_t>((6 + c) * count + k - 1 - lo)] : 0.0);
+            const int node = node_offset(rod) + k;
+            Mat3 block;
+            block << e[0], e[1], e[2], e[1], e[3], e[4], e[2], e[4], e[5];
+            blocks.emplace_back(node, (scale * inverse_voronoi_(node)) * block);
+          }
+          i = end;
         }
-        i = end;
       }
     }
   }
