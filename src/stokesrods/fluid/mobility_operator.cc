@@ -352,8 +352,13 @@ void MatrixFreeRssMobility::FindNearBlocks(const Matrix3X& targets, NearBlocks* 
           flags.resize(static_cast<size_t>(count));
           MarkNearSegments(p, first, count, ax.data(), ay.data(), az.data(), vx.data(), vy.data(),
                            vz.data(), inv_v2.data(), e2.data(), reach2.data(), flags.data());
-          for (int k = 0; k < count; ++k)
-            if (flags[static_cast<size_t>(k)]) near.push_back(first + k);
+          std::size_t found = near.size();  // branch-free: write every index, keep the near
+          near.resize(found + static_cast<size_t>(count));
+          for (int k = 0; k < count; ++k) {
+            near[found] = first + k;
+            found += flags[static_cast<size_t>(k)];
+          }
+          near.resize(found);
         }
         std::vector<std::pair<int, Mat3>>& blocks = per_target[static_cast<size_t>(t)];
         blocks.clear();
@@ -390,15 +395,20 @@ void MatrixFreeRssMobility::FindNearBlocks(const Matrix3X& targets, NearBlocks* 
       }
     }
   }
-  out->start.assign(1, 0);
-  out->source.clear();
-  out->block.clear();
-  for (const auto& blocks : per_target) {
-    for (const auto& [node, block] : blocks) {
-      out->source.push_back(node);
-      out->block.push_back(block);
+  out->start.resize(static_cast<size_t>(m) + 1);
+  out->start[0] = 0;
+  for (int t = 0; t < m; ++t)
+    out->start[static_cast<size_t>(t) + 1] =
+        out->start[static_cast<size_t>(t)] + static_cast<int>(per_target[static_cast<size_t>(t)].size());
+  out->source.resize(static_cast<size_t>(out->start.back()));
+  out->block.resize(static_cast<size_t>(out->start.back()));
+#pragma omp parallel for schedule(static)
+  for (int t = 0; t < m; ++t) {
+    auto k = static_cast<size_t>(out->start[static_cast<size_t>(t)]);
+    for (const auto& [node, block] : per_target[static_cast<size_t>(t)]) {
+      out->source[k] = node;
+      out->block[k++] = block;
     }
-    out->start.push_back(static_cast<int>(out->source.size()));
   }
 }
 
