@@ -54,6 +54,23 @@ def run(binary, config, out, resume, extra, threads=1):
                             env=dict(os.environ, OMP_NUM_THREADS=str(threads)))
 
 
+def wait_for_handlers(p):
+    """Until the run catches SIGINT and SIGTERM (SigCgt in /proc/PID/status) or has exited: a
+    signal before main() installs its handlers ends the process by its default action, which
+    says nothing about the resume (and on a loaded machine the start-up takes long enough for
+    an early random moment to land there). Where /proc is missing, returns at once."""
+    wanted = (1 << (signal.SIGINT - 1)) | (1 << (signal.SIGTERM - 1))
+    while p.poll() is None:
+        try:
+            with open(f"/proc/{p.pid}/status") as f:
+                caught = next(int(line.split()[1], 16) for line in f if line.startswith("SigCgt:"))
+        except (OSError, StopIteration, ValueError):
+            return
+        if caught & wanted == wanted:
+            return
+        time.sleep(0.002)
+
+
 def outputs(directory):
     """Every file of a run directory, relative paths."""
     files = []
@@ -133,6 +150,7 @@ def main():
             name = list(SIGNALS)[(trial + attempts) % len(SIGNALS)]
             delay = rng.uniform(0.05, 0.9) * whole
             p = run(args.binary, config, out, resume, extra, threads)
+            wait_for_handlers(p)
             try:
                 _, err = p.communicate(timeout=delay)
             except subprocess.TimeoutExpired:

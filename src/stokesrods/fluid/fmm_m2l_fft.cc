@@ -145,6 +145,18 @@ void Twiddles(int K, int J, int N, double sign, bool half_weights, std::vector<T
     }
 }
 
+/// The four tables of Forward and Inverse for the order p and grid N (computed once per sum).
+template <class T>
+void MakeTwiddles(int p, int N, FftTwiddles<T>* tw) {
+  const int H = (N + 1) / 2;
+  Twiddles<T>(H, p, N, -1.0, false, &tw->forward_z_re, &tw->forward_z_im);
+  Twiddles<T>(N, p, N, -1.0, false, &tw->forward_re, &tw->forward_im);
+  Twiddles<T>(p, N, N, 1.0, false, &tw->inverse_re, &tw->inverse_im);
+  Twiddles<T>(p, H, N, 1.0, true, &tw->inverse_z_re, &tw->inverse_z_im);
+  tw->order = p;
+  tw->grid = N;
+}
+
 /// The steps of one transform, each a set of slices × column chunks run by OpenMP (every output
 /// written by one work item: deterministic).
 template <class F>
@@ -158,24 +170,22 @@ void ForSlices(int slices, std::ptrdiff_t len, const F& body) {
   }
 }
 
-/// v's first n elements to write into: it grows when too short and never shrinks, so that the
-/// levels of one Apply, of different sizes, do not fill their buffers with zeros every time.
+/// Makes v at least n long: it grows when too short and never shrinks, so that the levels of one
+/// Apply, of different sizes, do not fill their buffers with zeros every time.
 template <class T>
-T* Grow(std::vector<T>* v, std::size_t n) {
+void Grow(std::vector<T>* v, std::size_t n) {
   if (v->size() < n) v->resize(n);
-  return v->data();
 }
 
 /// out (re, im: N × N × (N+1)/2 × L) = the transform of in (P × P × P × L, real), the batch of L
 /// columns innermost; `temp_*` grow as needed (Grow).
 template <class T>
-void Forward(int P, int N, std::ptrdiff_t L, const T* in, T* out_re, T* out_im,
-             std::vector<T>* temp_re, std::vector<T>* temp_im, std::vector<T>* temp2_re,
-             std::vector<T>* temp2_im) {
+void Forward(int P, int N, std::ptrdiff_t L, const FftTwiddles<T>& tw, const T* in, T* out_re,
+             T* out_im, std::vector<T>* temp_re, std::vector<T>* temp_im,
+             std::vector<T>* temp2_re, std::vector<T>* temp2_im) {
   const int H = (N + 1) / 2;
-  std::vector<T> zr, zi, yr, yi;
-  Twiddles<T>(H, P, N, -1.0, false, &zr, &zi);
-  Twiddles<T>(N, P, N, -1.0, false, &yr, &yi);
+  const std::vector<T>&zr = tw.forward_z_re, &zi = tw.forward_z_im;
+  const std::vector<T>&yr = tw.forward_re, &yi = tw.forward_im;
   const auto a_size = static_cast<size_t>(P) * P * H * L, b_size = static_cast<size_t>(P) * N * H * L;
   Grow(temp_re, a_size);
   Grow(temp_im, a_size);
@@ -200,13 +210,12 @@ void Forward(int P, int N, std::ptrdiff_t L, const T* in, T* out_re, T* out_im,
 /// out (p × p × p × L, real) = the inverse transform, without N⁻³, of in (re, im: the half
 /// spectrum N × N × (N+1)/2 × L), at the first p points per axis.
 template <class T>
-void Inverse(int p, int N, std::ptrdiff_t L, const T* in_re, const T* in_im, T* out,
-             std::vector<T>* temp_re, std::vector<T>* temp_im, std::vector<T>* temp2_re,
-             std::vector<T>* temp2_im) {
+void Inverse(int p, int N, std::ptrdiff_t L, const FftTwiddles<T>& tw, const T* in_re,
+             const T* in_im, T* out, std::vector<T>* temp_re, std::vector<T>* temp_im,
+             std::vector<T>* temp2_re, std::vector<T>* temp2_im) {
   const int H = (N + 1) / 2;
-  std::vector<T> xr, xi, zr, zi;
-  Twiddles<T>(p, N, N, 1.0, false, &xr, &xi);
-  Twiddles<T>(p, H, N, 1.0, true, &zr, &zi);
+  const std::vector<T>&xr = tw.inverse_re, &xi = tw.inverse_im;
+  const std::vector<T>&zr = tw.inverse_z_re, &zi = tw.inverse_z_im;
   const auto b_size = static_cast<size_t>(p) * N * H * L, a_size = static_cast<size_t>(p) * p * H * L;
   Grow(temp_re, b_size);
   Grow(temp_im, b_size);
@@ -267,7 +276,9 @@ std::unique_ptr<M2lSpectra> MakeSpectra(const FmmOperators& op) {
   }
   const auto f_size = static_cast<size_t>(s->frequencies) * L;
   std::vector<double> re(f_size), im(f_size), t1, t2, t3, t4;
-  Forward<double>(N, N, L, kernel.data(), re.data(), im.data(), &t1, &t2, &t3, &t4);
+  FftTwiddles<double> twiddles;
+  MakeTwiddles(N, N, &twiddles);  // the whole lattice, N points per axis
+  Forward<double>(N, N, L, twiddles, kernel.data(), re.data(), im.data(), &t1, &t2, &t3, &t4);
   const double scale = 1.0 / (static_cast<double>(N) * N * N);
   // Block-major: block b of kBlock frequencies, offset o, 12 rows (component c's re, im).
   s->values.assign(static_cast<size_t>(s->stride) * kOffsets * 12, 0.0);
@@ -303,16 +314,34 @@ const M2lSpectra& GetM2lSpectra(const FmmOperators& op) {
   return *entry;
 }
 
+M2lByOffset SortByOffset(const FmmList& v_list) {
+  M2lByOffset sorted;
+  sorted.bucket.assign(kOffsets + 1, 0);
+  for (const int o : v_list.offset) ++sorted.bucket[static_cast<size_t>(o) + 1];
+  for (int o = 0; o < kOffsets; ++o)
+    sorted.bucket[static_cast<size_t>(o) + 1] += sorted.bucket[static_cast<size_t>(o)];
+  sorted.target.resize(v_list.box.size());
+  sorted.source.resize(v_list.box.size());
+  std::vector<int> next(sorted.bucket.begin(), sorted.bucket.end() - 1);
+  for (std::size_t t = 0; t + 1 < v_list.start.size(); ++t)
+    for (int e = v_list.start[t]; e < v_list.start[t + 1]; ++e) {
+      const auto slot = static_cast<size_t>(next[static_cast<size_t>(v_list.offset[static_cast<size_t>(e)])]++);
+      sorted.target[slot] = static_cast<int>(t);
+      sorted.source[slot] = v_list.box[static_cast<size_t>(e)];
+    }
+  return sorted;
+}
+
 template <class T>
-void AddM2lByFft(const M2lSpectra& spectra, const FmmList& v_list, const MatX& up, MatX* check,
-                 M2lFftScratch<T>* scratch) {
+void AddM2lByFft(const M2lSpectra& spectra, const M2lByOffset& entries, const MatX& up,
+                 MatX* check, M2lFftScratch<T>* scratch) {
   const int p = spectra.order, N = spectra.grid, F = spectra.frequencies;
   const auto stride = static_cast<std::ptrdiff_t>(spectra.stride);
   const auto n = static_cast<Eigen::Index>(spectra.surface_cell.size());
   const Eigen::Index B = up.cols();
   SR_ASSERT(up.rows() == 3 * n && check->rows() == 3 * n && check->cols() == B,
             "one column of 3n densities per box");
-  if (B == 0 || v_list.box.empty()) return;
+  if (B == 0 || entries.target.empty()) return;
   const std::ptrdiff_t L = 3 * B;
   // The upward densities on the lattice (the cube's inside zero), column d B + b.
   const auto cells = static_cast<std::ptrdiff_t>(p) * p * p;
@@ -328,7 +357,9 @@ void AddM2lByFft(const M2lSpectra& spectra, const FmmList& v_list, const MatX& u
   const auto f_size = static_cast<size_t>(F) * L;
   Grow(&scratch->spectrum_re, f_size);
   Grow(&scratch->spectrum_im, f_size);
-  Forward<T>(p, N, L, scratch->grid.data(), scratch->spectrum_re.data(),
+  if (scratch->twiddles.order != p || scratch->twiddles.grid != N)
+    MakeTwiddles(p, N, &scratch->twiddles);
+  Forward<T>(p, N, L, scratch->twiddles, scratch->grid.data(), scratch->spectrum_re.data(),
              scratch->spectrum_im.data(), &scratch->temp_re, &scratch->temp_im, &scratch->temp2_re,
              &scratch->temp2_im);
   // Block-major spectra (BlockProducts): g[block][box][component's re, im][kBlock].
@@ -365,23 +396,6 @@ void AddM2lByFft(const M2lSpectra& spectra, const FmmList& v_list, const MatX& u
         }
   };
   transpose(true, scratch->boxes.data());
-  // The entries by offset (stable: each box's entries keep their list order within an offset).
-  const auto entries = v_list.box.size();
-  scratch->bucket.assign(kOffsets + 1, 0);
-  for (const int o : v_list.offset) ++scratch->bucket[static_cast<size_t>(o) + 1];
-  for (int o = 0; o < kOffsets; ++o)
-    scratch->bucket[static_cast<size_t>(o) + 1] += scratch->bucket[static_cast<size_t>(o)];
-  Grow(&scratch->target, entries);
-  Grow(&scratch->source, entries);
-  {
-    std::vector<int> next(scratch->bucket.begin(), scratch->bucket.end() - 1);
-    for (Eigen::Index t = 0; t < B; ++t)
-      for (int e = v_list.start[static_cast<size_t>(t)]; e < v_list.start[static_cast<size_t>(t) + 1]; ++e) {
-        const auto slot = static_cast<size_t>(next[static_cast<size_t>(v_list.offset[static_cast<size_t>(e)])]++);
-        scratch->target[slot] = static_cast<int>(t);
-        scratch->source[slot] = v_list.box[static_cast<size_t>(e)];
-      }
-  }
   // The products, block of frequencies by block (each block's sums written by one thread; each
   // box's sum in the order (offset, list position) on any number of threads).
   const T* kernel = spectra_values<T>(spectra);
@@ -390,11 +404,11 @@ void AddM2lByFft(const M2lSpectra& spectra, const FmmList& v_list, const MatX& u
     T* sums = scratch->sums.data() + block * per_block;
     std::fill_n(sums, per_block, T(0));
     BlockProducts(kernel + static_cast<std::ptrdiff_t>(block) * kOffsets * 12 * kBlock,
-                  scratch->bucket.data(), scratch->target.data(), scratch->source.data(),
+                  entries.bucket.data(), entries.target.data(), entries.source.data(),
                   scratch->boxes.data() + block * per_block, sums);
   }
   transpose(false, scratch->sums.data());
-  Inverse<T>(p, N, L, scratch->spectrum_re.data(), scratch->spectrum_im.data(),
+  Inverse<T>(p, N, L, scratch->twiddles, scratch->spectrum_re.data(), scratch->spectrum_im.data(),
              scratch->grid.data(), &scratch->temp_re, &scratch->temp_im, &scratch->temp2_re,
              &scratch->temp2_im);
 #pragma omp parallel for schedule(static)
@@ -405,9 +419,9 @@ void AddM2lByFft(const M2lSpectra& spectra, const FmmList& v_list, const MatX& u
             scratch->grid[static_cast<size_t>(spectra.surface_cell[static_cast<size_t>(j)] * L + d * B + b)]);
 }
 
-template void AddM2lByFft<float>(const M2lSpectra&, const FmmList&, const MatX&, MatX*,
+template void AddM2lByFft<float>(const M2lSpectra&, const M2lByOffset&, const MatX&, MatX*,
                                  M2lFftScratch<float>*);
-template void AddM2lByFft<double>(const M2lSpectra&, const FmmList&, const MatX&, MatX*,
+template void AddM2lByFft<double>(const M2lSpectra&, const M2lByOffset&, const MatX&, MatX*,
                                   M2lFftScratch<double>*);
 
 }  // namespace stokesrods

@@ -44,24 +44,40 @@ struct M2lSpectra {
 /// The spectra of the operators' order (computed on first use, then cached with them).
 const M2lSpectra& GetM2lSpectra(const FmmOperators& op);
 
+/// The transforms' factors e^{∓2πi k j / N} (fmm_m2l_fft.cc), made at the first Apply.
+template <class T>
+struct FftTwiddles {
+  int order = 0, grid = 0;
+  std::vector<T> forward_z_re, forward_z_im, forward_re, forward_im;
+  std::vector<T> inverse_re, inverse_im, inverse_z_re, inverse_z_im;
+};
+
 /// Reusable buffers of AddM2lByFft.
 template <class T>
 struct M2lFftScratch {
   std::vector<T> grid, spectrum_re, spectrum_im, temp_re, temp_im, temp2_re, temp2_im, boxes, sums;
-  std::vector<int> bucket, target, source;
+  FftTwiddles<T> twiddles;
 };
+
+/// A level's V-list entries (target box t, source box s) grouped by offset, as AddM2lByFft takes
+/// them: made once per tree. Stable: each box's entries keep their list order within an offset.
+struct M2lByOffset {
+  std::vector<int> bucket;          ///< offset o's entries are [bucket[o], bucket[o + 1])
+  std::vector<int> target, source;  ///< per entry
+};
+M2lByOffset SortByOffset(const FmmList& v_list);
 
 /// check (3n × boxes, the level's downward check potentials) += Σ over each box's V list of the
 /// translations of the source boxes' upward densities (up, 3n × boxes), for boxes of width 1: the
 /// same sums as AddM2l over the level, in precision T (float for the single-precision sums of
 /// fmm_sum.cc). Deterministic: each box's entries in list order, on any number of threads.
 template <class T>
-void AddM2lByFft(const M2lSpectra& spectra, const FmmList& v_list, const MatX& up, MatX* check,
-                 M2lFftScratch<T>* scratch);
+void AddM2lByFft(const M2lSpectra& spectra, const M2lByOffset& entries, const MatX& up,
+                 MatX* check, M2lFftScratch<T>* scratch);
 
-extern template void AddM2lByFft<float>(const M2lSpectra&, const FmmList&, const MatX&, MatX*,
-                                        M2lFftScratch<float>*);
-extern template void AddM2lByFft<double>(const M2lSpectra&, const FmmList&, const MatX&, MatX*,
-                                         M2lFftScratch<double>*);
+extern template void AddM2lByFft<float>(const M2lSpectra&, const M2lByOffset&, const MatX&,
+                                        MatX*, M2lFftScratch<float>*);
+extern template void AddM2lByFft<double>(const M2lSpectra&, const M2lByOffset&, const MatX&,
+                                         MatX*, M2lFftScratch<double>*);
 
 }  // namespace stokesrods

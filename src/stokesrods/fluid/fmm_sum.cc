@@ -115,6 +115,7 @@ class FmmStokesletSum final : public StokesletSum {
   bool use_direct_ = true;
   const FmmOperators* op_ = nullptr;
   const M2lSpectra* spectra_ = nullptr;  // when options_.m2l_by_fft
+  std::vector<M2lByOffset> v_by_offset_;  // per level, when spectra_
   mutable M2lFftScratch<float> fft_single_;
   mutable M2lFftScratch<double> fft_double_;
   FmmTree tree_;
@@ -197,6 +198,9 @@ void FmmStokesletSum::Build(const Matrix3X& sources, const VecX& regularization,
     if (!use_direct_) {
       op_ = &GetFmmOperators(order, kCutoff);
       spectra_ = options_.m2l_by_fft ? &GetM2lSpectra(*op_) : nullptr;
+      v_by_offset_.clear();
+      if (spectra_ != nullptr)
+        for (const FmmList& v : tree_.v_lists) v_by_offset_.push_back(SortByOffset(v));
     }
   }
   stats_ = StokesletSumStats{};
@@ -392,10 +396,11 @@ void FmmStokesletSum::M2l(int level) const {
   MatX& check = check_[static_cast<size_t>(level)];
   check.setZero();
   if (spectra_ != nullptr) {
+    const M2lByOffset& entries = v_by_offset_[static_cast<size_t>(level)];
     if (single_)
-      AddM2lByFft(*spectra_, v, up, &check, &fft_single_);
+      AddM2lByFft(*spectra_, entries, up, &check, &fft_single_);
     else
-      AddM2lByFft(*spectra_, v, up, &check, &fft_double_);
+      AddM2lByFft(*spectra_, entries, up, &check, &fft_double_);
     return;
   }
 #pragma omp parallel
@@ -423,7 +428,7 @@ void FmmStokesletSum::Leaves(Matrix3X* w) const {
   {
     // The downward equivalent densities as sources, ε = 0 (L2T), in the sum's precision: in
     // single precision relative to the box's centre (rounding 1e-7 of the box, not of the cloud).
-    MatX surface(n, 7);
+    MatX surface(single_ ? 0 : n, 7);
     surface.col(3).setZero();
     Eigen::MatrixXf surface_f(single_ ? n : 0, 7);
     if (single_) {

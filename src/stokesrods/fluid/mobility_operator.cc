@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 
 #include "stokesrods/common/assert.h"
+#include "stokesrods/fluid/near_search.h"
 #include "stokesrods/fluid/rss.h"
 #include "stokesrods/fluid/rss_rows.h"
 #include "stokesrods/fluid/stokeslet_segment.h"
@@ -23,23 +24,6 @@ void MobilityOperator::SetLayout(const std::vector<HydroRod>& rods) {
 }
 
 namespace {
-
-// flags[k] = 1 where segment first + k is near p: |p − closest point|² + ε² < δ²|v|².
-__attribute__((target_clones("avx512f", "avx2", "default")))
-void MarkNearSegments(const Vec3& p, int first, int count, const double* ax, const double* ay,
-                      const double* az, const double* vx, const double* vy, const double* vz,
-                      const double* inv_v2, const double* e2, const double* reach2,
-                      unsigned char* flags) {
-  const double px = p.x(), py = p.y(), pz = p.z();
-#pragma omp simd
-  for (int k = 0; k < count; ++k) {
-    const int s = first + k;
-    const double dx = px - ax[s], dy = py - ay[s], dz = pz - az[s];
-    const double t = std::clamp((dx * vx[s] + dy * vy[s] + dz * vz[s]) * inv_v2[s], 0.0, 1.0);
-    const double rx = dx - t * vx[s], ry = dy - t * vy[s], rz = dz - t * vz[s];
-    flags[k] = rx * rx + ry * ry + rz * rz + e2[s] < reach2[s];
-  }
-}
 
 class DenseMobility final : public MobilityOperator {
  public:
@@ -121,6 +105,27 @@ class DenseMobility final : public MobilityOperator {
   mutable bool double_stale_ = false;  // matrix_ is not single_ yet
 };
 
+// out (compressed rows) from the blocks per target, packed in parallel.
+void PackNearBlocks(const std::vector<std::vector<std::pair<int, Mat3>>>& per_target,
+                    NearBlocks* out) {
+  const int m = static_cast<int>(per_target.size());
+  out->start.resize(static_cast<size_t>(m) + 1);
+  out->start[0] = 0;
+  for (int t = 0; t < m; ++t)
+    out->start[static_cast<size_t>(t) + 1] =
+        out->start[static_cast<size_t>(t)] + static_cast<int>(per_target[static_cast<size_t>(t)].size());
+  out->source.resize(static_cast<size_t>(out->start.back()));
+  out->block.resize(static_cast<size_t>(out->start.back()));
+#pragma omp parallel for schedule(static)
+  for (int t = 0; t < m; ++t) {
+    auto k = static_cast<size_t>(out->start[static_cast<size_t>(t)]);
+    for (const auto& [node, block] : per_target[static_cast<size_t>(t)]) {
+      out->source[k] = node;
+      out->block[k++] = block;
+    }
+  }
+}
+
 // Matrix-free RSS (see the header). With f_j = F_j/Λ_j the force densities at the nodes,
 //   8πμ U_t = Σ_segments (A_a f_a + A_b f_b)
 //           = Σ_far Σ_q w_q L S_ε(x_t − y_q) [(1 − α_q) f_a + α_q f_b]    (point Stokeslets)
@@ -172,6 +177,14 @@ class MatrixFreeRssMobility final : public MobilityOperator {
   void BuildSplit();
   // Keeps the cheaper of split_ and the rule with one more point (ChooseNearFarSplit).
   void ChooseSplitByCost();
+  // The near blocks at p (node, block) of its near segments (NearSegmentSearch::SegmentsNear).
+  struct NearRowScratch {
+    std::vector<double> table;
+    std::vector<char> is_near;
+  };
+  void NearPairBlocks(const Vec3& p, const std::vector<int>& near,
+                      const std::vector<RssRowKernel>& kernels, NearRowScratch* scratch,
+                      std::vector<std::pair<int, Mat3>>* blocks) const;
 
   FluidParams params_;
   double accuracy_;                 // of the far field, its quadrature and the near pairs
@@ -258,61 +271,23 @@ void MatrixFreeRssMobility::BuildSplit() {
   FindNearBlocks(nodes_, &near_);
 }
 
-// Near pairs by bounding boxes grown by the near reach: a rod's box, then its runs of
-// kChunkSegments consecutive segments (a long rod's box holds many targets that only a few of its
-// segments are near), then every segment of a run that passes at once (vectorized). Near segments
-// come out in rod order.
+// The near pairs by NearSegmentSearch (fluid/near_search.h: boxes per rod and per run of
+// consecutive segments grown by the near reach), their blocks by NearPairBlocks.
 void MatrixFreeRssMobility::FindNearBlocks(const Matrix3X& targets, NearBlocks* out) const {
-  const double delta2 = split_.near_delta * split_.near_delta;
-  const int num_segments = static_cast<int>(segments_.size());
-  // Per segment (structure of arrays): x_a, v = x_b − x_a, 1/|v|², ε², δ²|v|².
-  std::vector<double> ax(num_segments), ay(num_segments), az(num_segments), vx(num_segments),
-      vy(num_segments), vz(num_segments), inv_v2(num_segments), e2(num_segments),
-      reach2(num_segments);
-  // Boxes and reaches: rods first (index r), then chunks (num_rods() + chunk).
-  constexpr int kChunkSegments = 16;
-  std::vector<int> chunk_first_segment;  // per chunk; the rod's chunks are consecutive
-  std::vector<int> rod_first_chunk(static_cast<size_t>(num_rods()) + 1, 0);
-  for (int r = 0; r < num_rods(); ++r) {
-    rod_first_chunk[static_cast<size_t>(r)] = static_cast<int>(chunk_first_segment.size());
-    const int first = node_offset(r) - r, count = node_offset(r + 1) - node_offset(r) - 1;
-    for (int k = 0; k < count; k += kChunkSegments) chunk_first_segment.push_back(first + k);
-  }
-  rod_first_chunk.back() = static_cast<int>(chunk_first_segment.size());
-  chunk_first_segment.push_back(num_segments);
-  const std::size_t num_boxes = static_cast<size_t>(num_rods()) + chunk_first_segment.size() - 1;
-  std::vector<Eigen::AlignedBox3d> boxes(num_boxes);
-  std::vector<double> box_reach(num_boxes, 0.0);
-  std::vector<int> segment_chunk(static_cast<size_t>(num_segments));
-  for (std::size_t c = 0; c + 1 < chunk_first_segment.size(); ++c)
-    std::fill(segment_chunk.begin() + chunk_first_segment[c],
-              segment_chunk.begin() + chunk_first_segment[c + 1], static_cast<int>(c));
-  for (int s = 0; s < num_segments; ++s) {
-    const Segment& seg = segments_[static_cast<size_t>(s)];
-    const Vec3 xa = nodes_.col(seg.a), v = nodes_.col(seg.a + 1) - xa;
-    ax[s] = xa.x(), ay[s] = xa.y(), az[s] = xa.z(), vx[s] = v.x(), vy[s] = v.y(), vz[s] = v.z();
-    inv_v2[s] = 1.0 / v.squaredNorm();
-    e2[s] = seg.eps * seg.eps;
-    reach2[s] = delta2 * v.squaredNorm();
-    for (const std::size_t b : {static_cast<size_t>(seg.rod),
-                                static_cast<size_t>(num_rods() + segment_chunk[static_cast<size_t>(s)])}) {
-      boxes[b].extend(xa);
-      boxes[b].extend(Vec3(xa + v));
-      box_reach[b] = std::max(box_reach[b], std::sqrt(reach2[s]));
-    }
-  }
-  // The exact near pairs minus the far sum's rule, by rows of RssRowKernel over the range of a
-  // rod's segments that are near a target (vectorized; columns of segments in the range that
-  // are not near are left out), to the far field's accuracy.
+  std::vector<int> first_node(segments_.size()), rod_first_segment;
+  VecX eps(static_cast<Eigen::Index>(segments_.size()));
+  for (std::size_t s = 0; s < segments_.size(); ++s)
+    first_node[s] = segments_[s].a, eps(static_cast<Eigen::Index>(s)) = segments_[s].eps;
+  for (int r = 0; r <= num_rods(); ++r) rod_first_segment.push_back(node_offset(r) - r);
+  NearSegmentSearch search;
+  search.Build(nodes_, first_node, eps, rod_first_segment, split_.near_delta);
   std::vector<RssRowKernel> kernels;
   for (int r = 0; r < num_rods(); ++r)
     kernels.emplace_back(*rods_[static_cast<size_t>(r)].x,
                          params_.regularization * rods_[static_cast<size_t>(r)].radius,
                          accuracy_, split_.gauss_points);
-  const double scale = 1.0 / (8.0 * kPi * params_.viscosity);
   const int m = static_cast<int>(targets.cols());
-  std::vector<std::vector<std::pair<int, Mat3>>>& per_target = per_target_;
-  per_target.resize(static_cast<size_t>(m));
+  per_target_.resize(static_cast<size_t>(m));
   // Targets by blocks of kTargetBlock consecutive columns (a rod's nodes: close together): the
   // chunks near a block's bounding box are found once for the block, so that each target tests
   // only those (a test per target and rod was O(targets × rods): 5 % of the step at 100 helices).
@@ -320,95 +295,64 @@ void MatrixFreeRssMobility::FindNearBlocks(const Matrix3X& targets, NearBlocks* 
   const int num_blocks = (m + kTargetBlock - 1) / kTargetBlock;
 #pragma omp parallel
   {
-    std::vector<int> near;          // global segment indices near the target, in rod order
-    std::vector<int> block_chunks;  // the chunks near the block's box, in rod order
+    std::vector<int> near, block_chunks;
     std::vector<unsigned char> flags;
-    std::vector<double> table;
-    std::vector<char> is_near;
+    NearRowScratch scratch;
 #pragma omp for schedule(dynamic, 1)
     for (int tb = 0; tb < num_blocks; ++tb) {
       const int t_begin = tb * kTargetBlock, t_end = std::min(m, t_begin + kTargetBlock);
       Eigen::AlignedBox3d block_box;
       for (int t = t_begin; t < t_end; ++t) block_box.extend(Vec3(targets.col(t)));
-      block_chunks.clear();
-      for (int r = 0; r < num_rods(); ++r) {
-        if (boxes[static_cast<size_t>(r)].exteriorDistance(block_box) >=
-            box_reach[static_cast<size_t>(r)])
-          continue;
-        for (int c = rod_first_chunk[static_cast<size_t>(r)];
-             c < rod_first_chunk[static_cast<size_t>(r) + 1]; ++c) {
-          const auto b = static_cast<size_t>(num_rods() + c);
-          if (boxes[b].exteriorDistance(block_box) < box_reach[b]) block_chunks.push_back(c);
-        }
-      }
+      search.ChunksNear(block_box, &block_chunks);
       for (int t = t_begin; t < t_end; ++t) {
-        const Vec3 p = targets.col(t);
-        near.clear();
-        for (const int c : block_chunks) {
-          const auto b = static_cast<size_t>(num_rods() + c);
-          if (boxes[b].exteriorDistance(p) >= box_reach[b]) continue;
-          const int first = chunk_first_segment[static_cast<size_t>(c)];
-          const int count = chunk_first_segment[static_cast<size_t>(c) + 1] - first;
-          flags.resize(static_cast<size_t>(count));
-          MarkNearSegments(p, first, count, ax.data(), ay.data(), az.data(), vx.data(), vy.data(),
-                           vz.data(), inv_v2.data(), e2.data(), reach2.data(), flags.data());
-          std::size_t found = near.size();  // branch-free: write every index, keep the near
-          near.resize(found + static_cast<size_t>(count));
-          for (int k = 0; k < count; ++k) {
-            near[found] = first + k;
-            found += flags[static_cast<size_t>(k)];
-          }
-          near.resize(found);
-        }
-        std::vector<std::pair<int, Mat3>>& blocks = per_target[static_cast<size_t>(t)];
-        blocks.clear();
-        for (std::size_t i = 0; i < near.size();) {  // one rod at a time (segments in rod order)
-          const int rod = segments_[static_cast<size_t>(near[i])].rod;
-          const int rod_first_segment = node_offset(rod) - rod;  // N_k − 1 segments per rod
-          std::size_t end = i;
-          while (end < near.size() && segments_[static_cast<size_t>(near[end])].rod == rod) ++end;
-          const int lo = near[i] - rod_first_segment, hi = near[end - 1] - rod_first_segment;
-          const int count = hi - lo + 1;
-          table.resize(static_cast<size_t>(12 * count));
-          is_near.assign(static_cast<size_t>(count), 0);
-          for (std::size_t k = i; k < end; ++k)
-            is_near[static_cast<size_t>(near[k] - rod_first_segment - lo)] = 1;
-          const RssRowKernel& kernel = kernels[static_cast<size_t>(rod)];
-          kernel.Row(p, lo, count, table.data());
-          kernel.SubtractRule(p, lo, count, table.data());
-          // Node k (local) collects A_a of segment k and A_b of segment k − 1, near ones only.
-          for (int k = lo; k <= hi + 1; ++k) {
-            const bool a_near = k <= hi && is_near[static_cast<size_t>(k - lo)];
-            const bool b_near = k > lo && is_near[static_cast<size_t>(k - 1 - lo)];
-            if (!a_near && !b_near) continue;
-            double e[6];
-            for (int c = 0; c < 6; ++c)
-              e[c] = (a_near ? table[static_cast<size_t>(c * count + k - lo)] : 0.0) +
-                     (b_near ? table[static_cast<size_t>((6 + c) * count + k - 1 - lo)] : 0.0);
-            const int node = node_offset(rod) + k;
-            Mat3 block;
-            block << e[0], e[1], e[2], e[1], e[3], e[4], e[2], e[4], e[5];
-            blocks.emplace_back(node, (scale * inverse_voronoi_(node)) * block);
-          }
-          i = end;
-        }
+        search.SegmentsNear(targets.col(t), block_chunks, &flags, &near);
+        NearPairBlocks(targets.col(t), near, kernels, &scratch, &per_target_[static_cast<size_t>(t)]);
       }
     }
   }
-  out->start.resize(static_cast<size_t>(m) + 1);
-  out->start[0] = 0;
-  for (int t = 0; t < m; ++t)
-    out->start[static_cast<size_t>(t) + 1] =
-        out->start[static_cast<size_t>(t)] + static_cast<int>(per_target[static_cast<size_t>(t)].size());
-  out->source.resize(static_cast<size_t>(out->start.back()));
-  out->block.resize(static_cast<size_t>(out->start.back()));
-#pragma omp parallel for schedule(static)
-  for (int t = 0; t < m; ++t) {
-    auto k = static_cast<size_t>(out->start[static_cast<size_t>(t)]);
-    for (const auto& [node, block] : per_target[static_cast<size_t>(t)]) {
-      out->source[k] = node;
-      out->block[k++] = block;
+  PackNearBlocks(per_target_, out);
+}
+
+void MatrixFreeRssMobility::NearPairBlocks(const Vec3& p, const std::vector<int>& near,
+                                           const std::vector<RssRowKernel>& kernels,
+                                           NearRowScratch* scratch,
+                                           std::vector<std::pair<int, Mat3>>* blocks) const {
+  // The exact near pairs minus the far sum's rule, by rows of RssRowKernel over the range of a
+  // rod's segments that are near p (vectorized; columns of segments in the range that are not
+  // near are left out), to the far field's accuracy.
+  const double scale = 1.0 / (8.0 * kPi * params_.viscosity);
+  std::vector<double>& table = scratch->table;
+  std::vector<char>& is_near = scratch->is_near;
+  blocks->clear();
+  for (std::size_t i = 0; i < near.size();) {  // one rod at a time (segments in rod order)
+    const int rod = segments_[static_cast<size_t>(near[i])].rod;
+    const int rod_first_segment = node_offset(rod) - rod;  // N_k − 1 segments per rod
+    std::size_t end = i;
+    while (end < near.size() && segments_[static_cast<size_t>(near[end])].rod == rod) ++end;
+    const int lo = near[i] - rod_first_segment, hi = near[end - 1] - rod_first_segment;
+    const int count = hi - lo + 1;
+    table.resize(static_cast<size_t>(12 * count));
+    is_near.assign(static_cast<size_t>(count), 0);
+    for (std::size_t k = i; k < end; ++k)
+      is_near[static_cast<size_t>(near[k] - rod_first_segment - lo)] = 1;
+    const RssRowKernel& kernel = kernels[static_cast<size_t>(rod)];
+    kernel.Row(p, lo, count, table.data());
+    kernel.SubtractRule(p, lo, count, table.data());
+    // Node k (local) collects A_a of segment k and A_b of segment k − 1, near ones only.
+    for (int k = lo; k <= hi + 1; ++k) {
+      const bool a_near = k <= hi && is_near[static_cast<size_t>(k - lo)];
+      const bool b_near = k > lo && is_near[static_cast<size_t>(k - 1 - lo)];
+      if (!a_near && !b_near) continue;
+      double e[6];
+      for (int c = 0; c < 6; ++c)
+        e[c] = (a_near ? table[static_cast<size_t>(c * count + k - lo)] : 0.0) +
+               (b_near ? table[static_cast<size_t>((6 + c) * count + k - 1 - lo)] : 0.0);
+      const int node = node_offset(rod) + k;
+      Mat3 block;
+      block << e[0], e[1], e[2], e[1], e[3], e[4], e[2], e[4], e[5];
+      blocks->emplace_back(node, (scale * inverse_voronoi_(node)) * block);
     }
+    i = end;
   }
 }
 

@@ -58,6 +58,13 @@ void DenseLu<Scalar>::Solve(Vector* b, bool use_lapack) const {
   SR_ASSERT(info == 0, "DenseLu: bad argument to getrs");
 }
 
+template <typename Scalar>
+void DenseLu<Scalar>::Prefetch() const {
+  const char* p = reinterpret_cast<const char*>(lu_.data());
+  const std::size_t bytes = sizeof(Scalar) * static_cast<std::size_t>(lu_.size());
+  for (std::size_t b = 0; b < bytes; b += 64) __builtin_prefetch(p + b, 0, 2);
+}
+
 template class DenseLu<float>;
 template class DenseLu<double>;
 
