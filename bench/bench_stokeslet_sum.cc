@@ -4,7 +4,8 @@
 // the FMM (0: the direct sum), at the tolerance that selects it. Counters: the error (the norm of
 // stokeslet_sum.h, against the direct sum, one random g), the pairs summed exactly (near) and by
 // expansions (far), the memory, 3n. A third argument, 0, takes the FMM's M2L summed directly
-// instead of by Fourier transforms (the reference, fmm_m2l_fft.h).
+// instead of by Fourier transforms (the reference, fmm_m2l_fft.h); 2 builds the tree even where
+// the cost model would sum directly.
 // Run: OMP_NUM_THREADS=1 build/release/bench/bench_stokeslet_sum --benchmark_repetitions=3
 //        --benchmark_report_aggregates_only=true   (and OMP_NUM_THREADS=2)
 #include <benchmark/benchmark.h>
@@ -12,6 +13,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <random>
 
@@ -33,10 +35,13 @@ Lattice HelixLattice(int helices) {
 }
 
 // The tolerance of each order (fmm_sum.cc); the FMM's own cost model decides whether it is used.
-std::unique_ptr<StokesletSum> MakeSum(int order, bool m2l_by_fft = true) {
+// variant: 1 M2L by Fourier transforms, 0 summed directly, 2 by transforms with the tree built
+// whatever the cost model says (to time what it estimates).
+std::unique_ptr<StokesletSum> MakeSum(int order, int variant = 1) {
   if (order == 0) return MakeDirectStokesletSum();
   const double tolerance = order == 4 ? 1e-4 : order == 5 ? 2.1e-5 : 1.25e-6;
-  return MakeFastStokesletSum({.tolerance = tolerance, .m2l_by_fft = m2l_by_fft});
+  return MakeFastStokesletSum(
+      {.tolerance = tolerance, .choose_by_cost = variant != 2, .m2l_by_fft = variant != 0});
 }
 
 Matrix3X RandomStrengths(Eigen::Index n) {
@@ -71,14 +76,14 @@ void SetCounters(benchmark::State& st, const StokesletSum& sum, const Lattice& c
 // Arguments: helices, order (0 = the direct sum).
 void BM_StokesletSumBuild(benchmark::State& st) {
   const Lattice c = HelixLattice(static_cast<int>(st.range(0)));
-  auto sum = MakeSum(static_cast<int>(st.range(1)));
+  auto sum = MakeSum(static_cast<int>(st.range(1)), static_cast<int>(st.range(2)));
   for (auto _ : st) sum->Build(c.sources, c.regularization, c.targets);
   SetCounters(st, *sum, c);
 }
 
 void BM_StokesletSumApply(benchmark::State& st) {
   const Lattice c = HelixLattice(static_cast<int>(st.range(0)));
-  auto sum = MakeSum(static_cast<int>(st.range(1)), st.range(2) != 0);
+  auto sum = MakeSum(static_cast<int>(st.range(1)), static_cast<int>(st.range(2)));
   sum->Build(c.sources, c.regularization, c.targets);
   const Matrix3X g = RandomStrengths(c.sources.cols());
   Matrix3X w;
@@ -93,16 +98,16 @@ void BM_StokesletSumApply(benchmark::State& st) {
 void Cases(benchmark::internal::Benchmark* b) {
   for (int helices : {10, 20, 50, 100})
     for (int order : {0, 4, 5, 6})
-      for (int fft : {1, 0})
-        if (order > 0 || fft == 1) b->Args({helices, order, fft});
+      for (int variant : {1, 0, 2})
+        if (order > 0 || variant == 1) b->Args({helices, order, variant});
 }
 BENCHMARK(BM_StokesletSumBuild)->Apply(Cases)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_StokesletSumApply)->Apply(Cases)->Unit(benchmark::kMillisecond);
 
 // The coarse level's sum of the preconditioner (sim/coarse_level.h): 8 chunks of consecutive
 // nodes per helix, each a point Stokeslet at its centroid, summed at all nodes at tolerance 1e-3.
-// Arguments: helices; 1 the fast sum (its cost model decides), 0 the direct sum in single
-// precision.
+// Arguments: helices; 1 the fast sum (its cost model decides), 2 the FMM's tree whatever the cost
+// model says, 0 the direct sum in single precision. Counter build_ms: one Build.
 void BM_CentroidSum(benchmark::State& st) {
   const Lattice c = HelixLattice(static_cast<int>(st.range(0)));
   constexpr int kNodes = 65, kChunks = 8;
@@ -115,9 +120,13 @@ void BM_CentroidSum(benchmark::State& st) {
           c.targets.middleCols(h * kNodes + begin, end - begin).rowwise().mean();
     }
   const VecX eps = VecX::Constant(centroids.cols(), 1.02e-3);
-  auto sum = st.range(1) != 0 ? MakeFastStokesletSum({.tolerance = 1e-3})
-                              : MakeDirectStokesletSum(true);
+  auto sum = st.range(1) != 0
+                 ? MakeFastStokesletSum({.tolerance = 1e-3, .choose_by_cost = st.range(1) == 1})
+                 : MakeDirectStokesletSum(true);
+  const auto start = std::chrono::steady_clock::now();
   sum->Build(centroids, eps, c.targets);
+  st.counters["build_ms"] =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   const Matrix3X g = RandomStrengths(centroids.cols());
   Matrix3X w;
   for (auto _ : st) {
@@ -129,7 +138,7 @@ void BM_CentroidSum(benchmark::State& st) {
                                             static_cast<double>(c.targets.cols()));
   st.counters["near_pairs"] = static_cast<double>(stats.near_pairs);
 }
-BENCHMARK(BM_CentroidSum)->ArgsProduct({{20, 50, 100}, {1, 0}})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_CentroidSum)->ArgsProduct({{20, 50, 100}, {1, 2, 0}})->Unit(benchmark::kMillisecond);
 
 // The V-list translations of one level alone: 64 boxes, each taking the first `entries` of the
 // 316 offsets (all: 20 224 M2Ls) from random source boxes. Arguments: order p; 1 by Fourier

@@ -154,6 +154,12 @@ constexpr std::array<double, 3> kOrderError = {6.4e-5, 1.4e-5, 8.1e-7};  // p = 
 
 /// The far part's cost in a whole Apply over its estimate from BM_M2lLevel's constants.
 constexpr double kFarCostInApply = 1.5;
+/// A whole Apply over its estimate, and the Build per point in pairs of the direct sum (0.41 ns
+/// each here), measured on five trees (BM_StokesletSum{Build,Apply}/{20,50,100}/4/2 and
+/// BM_CentroidSum/{50,100}/2, one thread, idle): Apply 1.05, 1.19, 1.13, 1.29, 1.18 × its
+/// estimate; Build 264, 338, 375, 308, 317 pairs per point (docs/performance.md, "Session 13").
+constexpr double kApplyOverEstimate = 1.18;
+constexpr double kBuildPerPoint = 350.0;
 
 /// p for the options; 0 when no order reaches the tolerance.
 int OrderFor(const StokesletSumOptions& options) {
@@ -191,6 +197,8 @@ void FmmStokesletSum::Build(const Matrix3X& sources, const VecX& regularization,
     // 8.3 M, and a 4–5 % faster Apply (docs/performance.md, session 12).
     cost.per_m2l *= kFarCostInApply;
     cost.per_box *= kFarCostInApply;
+    cost.apply_scale = kApplyOverEstimate;
+    cost.per_point_build = kBuildPerPoint / std::max(1.0, options_.applies_per_build);
     const double eps_max = regularization.size() > 0 ? regularization.cwiseAbs().maxCoeff() : 0.0;
     const double min_width = eps_max * std::pow(kEpsilonConstant / options_.tolerance, 0.25);
     tree_ = BuildFmmTree(sources, targets, min_width, cost, !options_.choose_by_cost);

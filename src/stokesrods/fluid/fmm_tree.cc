@@ -11,10 +11,6 @@
 namespace stokesrods {
 namespace {
 
-/// A tree is built only where its estimated cost is below this share of the direct sum's pairs
-/// (see BuildFmmTree).
-constexpr double kTreePays = 0.65;
-
 constexpr int kMaxLevel = 20;  // Morton codes of 3 × 20 bits
 
 std::uint64_t Spread(std::uint64_t v) {  // bits b → 3b
@@ -258,6 +254,11 @@ class LevelGrid {
   std::vector<std::int64_t> sources_, targets_, count_sum_, occupied_sum_;
 };
 
+/// The estimated cost of one Apply and its share of the Build, in pairs of the direct sum.
+double Total(const FmmCost& cost, double far, double near, double points) {
+  return cost.apply_scale * (far + near) + cost.per_point_build * points;
+}
+
 /// The least estimated cost over the depths ≥ 2 (as BuildFmmTree's loop counts it) of the tree
 /// whose root cube of side `width` starts at `corner`, from LevelGrid's counts, and its depth.
 /// Not `complete` when a level's grid was too large to count densely before the search ended
@@ -283,7 +284,7 @@ LeastCostDepth LeastCost(const Matrix3X& sources, const Matrix3X& targets, const
     double boxes = 0.0, m2l = 0.0, near = 0.0;
     grid.Count(&boxes, &m2l, &near);
     far_cost += cost.per_box * boxes + cost.per_m2l * m2l;
-    const double total = far_cost + near;
+    const double total = Total(cost, far_cost, near, points);
     if (total < best.cost) best.cost = total, best.depth = level;
     if (total > 2.0 * best.cost || boxes >= points) break;
   }
@@ -314,12 +315,9 @@ FmmTree BuildFmmTree(const Matrix3X& sources, const Matrix3X& targets, double mi
   tree.width = extent * (1.0 + 1e-9);
   const double pairs = static_cast<double>(sources.cols()) * static_cast<double>(targets.cols());
   // Whether the tree pays is decided on the root of side `extent` alone, as before the choice of
-  // widths below, and only below kTreePays of the direct sum's pairs: the estimate is optimistic
-  // (10 helices, 1280 × 650 points: a wider root estimated at 0.98 of the pairs ran 1.16× slower
-  // than the direct sum; with the M2L by FFT, Apply ran 1.23, 1.42 and 1.50× its estimate on 20,
-  // 50 and 100 helices, and the 20-helix step, its tree estimated at 0.73, 1.10× slower than
-  // with the direct sum: the tree's Build is not in the estimate).
-  const double direct_cost = kTreePays * pairs;
+  // widths below (10 helices, 1280 × 650 points: a wider root estimated at 0.98 of the pairs ran
+  // 1.16× slower than the direct sum), against the direct sum's pairs.
+  const double direct_cost = pairs;
   LeastCostDepth least = LeastCost(sources, targets, tree.corner, tree.width, min_leaf_width, cost);
   if (!force_tree && least.complete && least.cost >= direct_cost) return FmmTree{};
   // The root's side, extent × 2^(k/4), k = 0 … 3: leaves of any width within a factor 2^(1/8)
@@ -349,7 +347,7 @@ FmmTree BuildFmmTree(const Matrix3X& sources, const Matrix3X& targets, double mi
                 cost.per_m2l * static_cast<double>(tree.v_lists.back().box.size());
     std::int64_t near = 0;
     MakeNearList(tree.levels.back(), level, &near);
-    const double total = far_cost + static_cast<double>(near);
+    const double total = Total(cost, far_cost, static_cast<double>(near), points);
     if (total < best) {
       best = total;
       tree.depth = level;

@@ -35,6 +35,10 @@ struct FmmCost {
   double per_point = 0.0;  ///< S2M and L2T: a source or target against a surface
   double per_box = 0.0;    ///< the dense translations of one box (M2M, L2L, check → equivalent)
   double per_m2l = 0.0;    ///< one M2L (a V-list pair of boxes)
+  /// A whole Apply over the sum of the pieces above and its near pairs (scales them all alike:
+  /// it does not change the depth, only whether the tree pays).
+  double apply_scale = 1.0;
+  double per_point_build = 0.0;  ///< the Build's cost per point, per Apply it serves
 };
 
 struct FmmTree {
@@ -53,7 +57,8 @@ struct FmmTree {
 
 /// The tree over sources and targets with leaves no narrower than min_leaf_width [m], of the
 /// depth of least estimated cost; depth 0 (no tree) when the points span nothing or no depth
-/// ≥ 2 fits. When `force_tree` is false, also depth 0 when the direct sum is estimated cheaper.
+/// ≥ 2 fits. When `force_tree` is false, also depth 0 when the direct sum (one unit per pair) is
+/// estimated cheaper than the tree's Apply plus its share of the Build.
 FmmTree BuildFmmTree(const Matrix3X& sources, const Matrix3X& targets, double min_leaf_width,
                      const FmmCost& cost, bool force_tree);
 

@@ -35,6 +35,10 @@ struct StokesletSumOptions {
   /// The FMM's V-list translations by Fourier transforms (fmm_m2l_fft.h); false: each evaluated
   /// directly as a sum of the source box's equivalent Stokeslets (the reference, for tests).
   bool m2l_by_fft = true;
+  /// Applies expected per Build: the tree's cost model charges each Apply this share of the
+  /// Build's (fmm_sum.cc). The mobility's far sum is built every step and applied ~5 times; the
+  /// preconditioner's coarse sum is built with the preconditioner (at most every 40 steps).
+  double applies_per_build = 5.0;
 };
 
 /// What a Build produced (for tests and benchmarks).
@@ -43,7 +47,8 @@ struct StokesletSumStats {
   std::int64_t far_pairs = 0;   ///< (target, source) pairs summed by expansions
   std::int64_t stored_values = 0;  ///< doubles stored by Build (points, expansions)
   int max_rank = 0;                ///< rank of the compressed M2L translations
-  /// Estimated cost of one Apply in kernel evaluations (the direct sum: sources × targets).
+  /// Estimated cost of one Apply with its share of the Build, in kernel evaluations (the direct
+  /// sum: sources × targets).
   double cost = 0.0;
 };
 
