@@ -12,9 +12,10 @@
 // neighbour leaves summed in one call (AddPointSumBlocks: no remainder loops, one reduction).
 // Every box's work is done by one thread, in a fixed order: Apply is deterministic.
 //
-// DEPTH. The tree is cut at the depth of least estimated cost (FmmCost: kernel evaluations of the
-// near field, S2M and L2T, n² per M2L, the dense translations per box), and the sum is direct
-// where that cost is not below S·T (unless forced, for tests). An M2L by Fourier transforms costs
+// DEPTH. The tree is cut at the depth of least estimated cost (FmmCost, fmm_cost.h: kernel
+// evaluations of the near field, S2M and L2T, n² per M2L, the dense translations per box, and
+// the Apply's share of the Build), and the sum is direct where that cost is not below S·T
+// (unless forced, for tests). An M2L by Fourier transforms costs
 // about 345 kernel evaluations at p = 4 (the direct one n² = 3136), and the leaf width is chosen
 // finer than a factor 2: the root cube's side is extent × 2^(k/4), k = 0 … 3, by the same cost
 // (fmm_tree.cc). On the 100-helix lattice: 8.3 M near pairs (10 % of all), where the direct M2L's
@@ -40,6 +41,7 @@
 #include <vector>
 
 #include "stokesrods/common/assert.h"
+#include "stokesrods/fluid/fmm_cost.h"
 #include "stokesrods/fluid/fmm_m2l_fft.h"
 #include "stokesrods/fluid/fmm_operators.h"
 #include "stokesrods/fluid/fmm_tree.h"
@@ -136,39 +138,6 @@ class FmmStokesletSum final : public StokesletSum {
   StokesletSumStats stats_;
 };
 
-// ORDER. Measured error (the header's norm; tests/fluid/stokeslet_sum_test.cc) with p points per
-// edge, the worst of random clouds (6 000 × 3 000 and 20 000 × 5 000 points in a cube) and helix
-// lattices (20 and 100 helices), pseudo-inverses cut at 1e-6 σ_max (smaller cutoffs were worse,
-// 1e-9 gave 1e-4 at p = 5: the fits amplify rounding):
-//     p            4        5        6
-//     3n           168      294      456      (n = p³ − (p−2)³ points per surface)
-//     error        6.4e-5   1.4e-5   8.1e-7
-// We take the smallest p whose error × 1.5 is within the tolerance: p = 4 from 1e-4, 5 from 2e-5,
-// 6 from 1.25e-6; below that no order (p = 7 would store 0.5 GB of K_v) and the sum is direct.
-// These are errors of many sources, where the exact near field dominates Σ|S||g|; one source
-// alone against targets just past its neighbour boxes (one box width away) is approximated far
-// worse, like any FMM on 1-separated boxes: worst of 20 placements 2e-2, 4e-2, 1.8e-4 relative
-// at p = 4, 5, 6.
-constexpr double kCutoff = 1e-6;
-constexpr std::array<double, 3> kOrderError = {6.4e-5, 1.4e-5, 8.1e-7};  // p = 4, 5, 6
-
-/// The far part's cost in a whole Apply over its estimate from BM_M2lLevel's constants.
-constexpr double kFarCostInApply = 1.5;
-/// A whole Apply over its estimate, and the Build per point in pairs of the direct sum (0.41 ns
-/// each here), measured on five trees (BM_StokesletSum{Build,Apply}/{20,50,100}/4/2 and
-/// BM_CentroidSum/{50,100}/2, one thread, idle): Apply 1.05, 1.19, 1.13, 1.29, 1.18 × its
-/// estimate; Build 264, 338, 375, 308, 317 pairs per point (docs/performance.md, "Session 13").
-constexpr double kApplyOverEstimate = 1.18;
-constexpr double kBuildPerPoint = 350.0;
-
-/// p for the options; 0 when no order reaches the tolerance.
-int OrderFor(const StokesletSumOptions& options) {
-  if (options.order > 0) return options.order;
-  for (int p = 4; p <= 6; ++p)
-    if (1.5 * kOrderError[static_cast<size_t>(p - 4)] <= options.tolerance) return p;
-  return 0;
-}
-
 void FmmStokesletSum::Build(const Matrix3X& sources, const VecX& regularization,
                             const Matrix3X& targets) {
   SR_ASSERT(regularization.size() == sources.cols(), "one ε per source");
@@ -177,34 +146,13 @@ void FmmStokesletSum::Build(const Matrix3X& sources, const VecX& regularization,
   tree_ = FmmTree{};
   const int order = OrderFor(options_);
   if (order > 0 && pairs >= static_cast<double>(options_.direct_below_pairs)) {
-    const double n = order * order * order - (order - 2) * (order - 2) * (order - 2);
-    // Costs in kernel evaluations (one pair of the near field): an M2L is n² of them (AddM2l),
-    // an entry of the dense per-box translations ≈ 0.05 (BLAS products over all boxes).
-    const double entries = 9.0 * n * n;
-    FmmCost cost{.per_point = n, .per_box = 0.05 * 4.0 * entries, .per_m2l = n * n};
-    if (options_.m2l_by_fft) {
-      // Measured (bench BM_M2lLevel, single precision, one thread, in near-field pairs of
-      // 0.45 ns): a product 1.66 per frequency of the padded spectrum (155 ns at p = 4, 310 at
-      // 5, 555 at 6); a box's transforms ≈ 2.5 × the 2 p H N (p + N) complex multiply–adds of
-      // one column (3.0, 7.0, 13.4 µs), H = p frequencies along z, N = 2p − 1.
-      const double grid = 2 * order - 1, stride = std::ceil(grid * grid * order / 16.0) * 16.0;
-      cost.per_m2l = 1.66 * stride;
-      cost.per_box += 2.5 * 2.0 * order * order * grid * (order + grid);
-    }
-    // Those constants are measured on one level of 64 boxes that stays in cache; in a whole
-    // Apply the far part costs more (the 100-helix lattice ran 1.5× its estimate, at session
-    // 11's constants): both ×1.5, which there takes the tree with 12.9 M near pairs instead of
-    // 8.3 M, and a 4–5 % faster Apply (docs/performance.md, session 12).
-    cost.per_m2l *= kFarCostInApply;
-    cost.per_box *= kFarCostInApply;
-    cost.apply_scale = kApplyOverEstimate;
-    cost.per_point_build = kBuildPerPoint / std::max(1.0, options_.applies_per_build);
+    const FmmCost cost = EstimatedFmmCost(order, options_);
     const double eps_max = regularization.size() > 0 ? regularization.cwiseAbs().maxCoeff() : 0.0;
     const double min_width = eps_max * std::pow(kEpsilonConstant / options_.tolerance, 0.25);
     tree_ = BuildFmmTree(sources, targets, min_width, cost, !options_.choose_by_cost);
     use_direct_ = tree_.depth == 0;
     if (!use_direct_) {
-      op_ = &GetFmmOperators(order, kCutoff);
+      op_ = &GetFmmOperators(order, kFmmCutoff);
       spectra_ = options_.m2l_by_fft ? &GetM2lSpectra(*op_) : nullptr;
       v_by_offset_.clear();
       if (spectra_ != nullptr)
