@@ -40,6 +40,7 @@
 #include "stokesrods/io/runner.h"
 #include "stokesrods/sim/integrator.h"
 #include "stokesrods/sim/state.h"
+#include "stokesrods/solver/blas.h"
 
 namespace stokesrods {
 namespace {
@@ -370,6 +371,7 @@ int main(int argc, char** argv) {
     }
   }
   j["threads"] = MaxThreads();
+  j["blas_core"] = stokesrods::BlasCoreName();
   j["peak_rss_mb"] = PeakRssMb();
   std::cout << j.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace) << '\n';
   std::cout.flush();

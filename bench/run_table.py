@@ -288,6 +288,9 @@ def main():
     load_end = os.getloadavg()
 
     print(f"Load average at end: {' '.join(f'{l:.2f}' for l in load_end)}")
+    cores = sorted({r["blas_core"] for r in rows if r.get("blas_core")})
+    if cores:
+        print(f"OpenBLAS kernels: {', '.join(cores)}")
     print()
     print(table(rows))
     print()

@@ -391,6 +391,42 @@ TEST(StokesletSumTest, SingleKernelOverAnyRangeMatchesThePlainSum) {
   }
 }
 
+// The sums at several targets at once (one read of each block of sources for all of them)
+// against the one-target sums, for 1 … kPointSumTargets targets, in double, in float and over
+// ranges of whole blocks: bit for bit, since each target's arithmetic and order are the same.
+TEST(StokesletSumTest, SeveralTargetsAtOnceEqualEachTargetAlone) {
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> unit(-0.1, 0.1);
+  const MatX src = RandomSourceRows(5 * kPointSumBlock + 3, &rng);
+  const Eigen::MatrixXf src_f = src.cast<float>();
+  const std::vector<SourceRange> ranges = {{0, 2 * kPointSumBlock},
+                                           {3 * kPointSumBlock, 5 * kPointSumBlock}};
+  const Eigen::Index begin = 2, end = src.rows() - 1;  // not whole blocks: the masked last one
+  for (int n = 1; n <= kPointSumTargets; ++n) {
+    Matrix3X x(3, n);
+    for (Eigen::Index k = 0; k < x.size(); ++k) x.data()[k] = unit(rng);
+    const Eigen::Matrix3Xf xf = x.cast<float>();
+    Matrix3X together = Matrix3X::Zero(3, 3 * n), alone = Matrix3X::Zero(3, 3 * n);
+    const double* xd[kPointSumTargets];
+    const float* xs[kPointSumTargets];
+    double* out[3][kPointSumTargets];
+    for (int k = 0; k < n; ++k) {
+      xd[k] = x.col(k).data(), xs[k] = xf.col(k).data();
+      for (int kind = 0; kind < 3; ++kind) out[kind][k] = together.col(kind * n + k).data();
+      AddPointSum(Columns(src), begin, end, x.col(k).data(), alone.col(k).data());
+      AddPointSumSingle(ColumnsF(src_f), begin, end, xf.col(k).data(), alone.col(n + k).data());
+      AddPointSumBlocks(ColumnsF(src_f), ranges.data(), 2, xf.col(k).data(),
+                        alone.col(2 * n + k).data());
+    }
+    AddPointSumTargets(Columns(src), begin, end, n, xd, out[0]);
+    AddPointSumSingleTargets(ColumnsF(src_f), begin, end, n, xs, out[1]);
+    AddPointSumBlocksTargets(ColumnsF(src_f), ranges.data(), 2, n, xs, out[2]);
+    EXPECT_GT(alone.cwiseAbs().minCoeff(), 0.0);
+    for (Eigen::Index k = 0; k < together.size(); ++k)
+      EXPECT_EQ(together.data()[k], alone.data()[k]) << n << " targets, entry " << k;
+  }
+}
+
 // A run resumes bit for bit on another thread count (tests/reliability/kill_resume.py), so the
 // fast sum's result must not depend on it: OpenMP splits only independent boxes (here 1 against 2
 // OpenMP threads), and the BLAS runs on one thread of its own (tests/solver: Blas.RunsOnOneThread…).

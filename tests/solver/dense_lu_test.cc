@@ -8,7 +8,9 @@
 #endif
 
 #include <algorithm>
+#include <cstdlib>
 #include <random>
+#include <string>
 
 #include <Eigen/LU>
 
@@ -121,6 +123,32 @@ TEST(Blas, RunsOnOneThreadOfItsOwn) {
   if (openblas_get_num_threads) {
     EXPECT_EQ(openblas_get_num_threads(), 1);
   }
+}
+
+// On a CPU with AVX2 and FMA the BLAS must not run its SSE3 fallback (OpenBLAS takes it on CPUs
+// newer than itself; solver/blas.cc then chooses by the CPU's features). The user's
+// OPENBLAS_CORETYPE stands, whatever it names.
+TEST(Blas, DoesNotRunTheOldestKernelsOnANewerCpu) {
+  const std::string core = BlasCoreName();
+  if (core.empty()) GTEST_SKIP() << "not OpenBLAS";
+  if (std::getenv("OPENBLAS_CORETYPE") != nullptr && std::string(std::getenv("OPENBLAS_CORETYPE")) != core)
+    GTEST_SKIP() << "OPENBLAS_CORETYPE set by the user";
+#if defined(__x86_64__)
+  if (!__builtin_cpu_supports("avx2") || !__builtin_cpu_supports("fma"))
+    GTEST_SKIP() << "no AVX2 here";
+  EXPECT_NE(core, "Prescott");
+  // A product and a factorization on the kernels chosen still agree with Eigen's.
+  std::mt19937 rng(3);
+  const Eigen::MatrixXf a = RandomMatrix<float>(300, &rng);
+  DenseLu<float> lu;
+  ASSERT_TRUE(lu.Compute(a));
+  const Eigen::VectorXf b = RandomMatrix<float>(300, &rng).col(0);
+  Eigen::VectorXf x = b;
+  lu.Solve(&x);
+  EXPECT_LT((a * x - b).norm(), 1e-4f * a.norm() * x.norm());
+#else
+  GTEST_SKIP() << "not x86-64";
+#endif
 }
 
 TEST(Blas, ProductsMatchEigen) {

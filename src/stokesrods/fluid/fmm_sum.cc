@@ -407,18 +407,30 @@ void FmmStokesletSum::Leaves(Matrix3X* w) const {
       }
       const SourceColumns far = Columns(surface);
       const SourceColumnsF far_f = single_ ? ColumnsF(surface_f) : SourceColumnsF{};
-      for (int t = box.tgt_begin; t < box.tgt_end; ++t) {
-        double* out = w->col(t).data();
-        const SourceRange* near = near_ranges_.data() + near_range_start_[b];
-        const int count = near_range_start_[b + 1] - near_range_start_[b];
+      const SourceRange* near = near_ranges_.data() + near_range_start_[b];
+      const int count = near_range_start_[b + 1] - near_range_start_[b];
+      // The box's targets by groups of kPointSumTargets, which share its sources.
+      for (int t0 = box.tgt_begin; t0 < box.tgt_end; t0 += kPointSumTargets) {
+        const int group = std::min(kPointSumTargets, box.tgt_end - t0);
+        double* out[kPointSumTargets];
+        for (int k = 0; k < group; ++k) out[k] = w->col(t0 + k).data();
         if (single_) {
-          const Eigen::Vector3f local = (x_.col(t) - centre).cast<float>();
-          AddPointSumSingle(far_f, 0, n, local.data(), out);
-          AddPointSumBlocks(columns_f, near, count, x_f_.col(t).data(), out);
+          Eigen::Matrix<float, 3, kPointSumTargets> local;
+          const float* x_local[kPointSumTargets];
+          const float* x_near[kPointSumTargets];
+          for (int k = 0; k < group; ++k) {
+            local.col(k) = (x_.col(t0 + k) - centre).cast<float>();
+            x_local[k] = local.col(k).data();
+            x_near[k] = x_f_.col(t0 + k).data();
+          }
+          AddPointSumSingleTargets(far_f, 0, n, group, x_local, out);
+          AddPointSumBlocksTargets(columns_f, near, count, group, x_near, out);
         } else {
-          AddPointSum(far, 0, n, x_.col(t).data(), out);
+          const double* x[kPointSumTargets];
+          for (int k = 0; k < group; ++k) x[k] = x_.col(t0 + k).data();
+          AddPointSumTargets(far, 0, n, group, x, out);
           for (int r = 0; r < count; ++r)
-            AddPointSum(columns, near[r].begin, near[r].end, x_.col(t).data(), out);
+            AddPointSumTargets(columns, near[r].begin, near[r].end, group, x, out);
         }
       }
     }

@@ -49,6 +49,20 @@ struct SourceRange {
 void AddPointSumBlocks(const SourceColumnsF& c, const SourceRange* ranges, int count,
                        const float* x, double* w);
 
+/// The most targets the *Targets sums below take at once.
+inline constexpr int kPointSumTargets = 4;
+
+/// AddPointSum, AddPointSumSingle and AddPointSumBlocks at n ≤ kPointSumTargets targets x[k]
+/// (adding to w[k]) over the same sources: each block of sources is read once for all n (one
+/// target alone reads 7 vectors per 16 pairs, and its loop ran at less than half the rate of the
+/// multiply–add pipes on an Intel Xeon). Each target's sum is bit for bit the one-target sum.
+void AddPointSumTargets(const SourceColumns& c, Eigen::Index begin, Eigen::Index end, int n,
+                        const double* const* x, double* const* w);
+void AddPointSumSingleTargets(const SourceColumnsF& c, Eigen::Index begin, Eigen::Index end,
+                              int n, const float* const* x, double* const* w);
+void AddPointSumBlocksTargets(const SourceColumnsF& c, const SourceRange* ranges, int count,
+                              int n, const float* const* x, double* const* w);
+
 /// The compiler-vectorized loops behind AddPointSum, AddPointSumSingle and AddPointSumBlocks on
 /// CPUs without AVX-512 (there the sums run on intrinsics; the tests check both paths).
 void PointSumPortable(const SourceColumns& c, Eigen::Index begin, Eigen::Index end,

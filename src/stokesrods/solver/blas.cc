@@ -1,6 +1,8 @@
 #include "stokesrods/solver/blas.h"
 
 #include <algorithm>
+#include <cstdlib>
+#include <cstring>
 
 extern "C" {
 void sgemv_(const char* trans, const int* m, const int* n, const float* alpha, const float* a,
@@ -18,10 +20,47 @@ void dgemv_(const char* trans, const int* m, const int* n, const double* alpha, 
 // of its own; our parallelism is OpenMP over independent pieces. Weak: absent with another BLAS.
 extern "C" void openblas_set_num_threads(int) __attribute__((weak));
 
+// OpenBLAS built for many CPUs (Debian's, DYNAMIC_ARCH) picks its kernels by the CPU's family and
+// model, and falls back to its oldest x86-64 ones ("Prescott": SSE3) on a model it does not know:
+// Debian 12's 0.3.21 does not know Intel's Xeons from Sapphire Rapids on (seen: family 6 model
+// 207, an Emerald Rapids, with AVX-512). There the FMM's translations (dgemm) and the
+// preconditioners' LU factorizations (sgetrf) run 3–4× slower than they could (perf on 100
+// helices: dgemm and sgemm 11.7 % of a step with the fallback, 2.3 % with SkylakeX's kernels).
+// OpenBLAS's own remedy is the environment variable OPENBLAS_CORETYPE, read when it loads, before
+// main(); so when it is unset and the fallback was taken on a CPU with AVX-512 (or AVX2 and FMA),
+// the variable is set here and OpenBLAS's kernel table chosen again by its own functions. Weak:
+// with another BLAS, or an OpenBLAS without them, nothing happens.
+extern "C" char* openblas_get_corename(void) __attribute__((weak));
+extern "C" void gotoblas_dynamic_init(void) __attribute__((weak));
+extern "C" void gotoblas_dynamic_quit(void) __attribute__((weak));
+
 namespace stokesrods {
 namespace {
 
+const char* BetterBlasCore() {
+#if defined(__x86_64__)
+  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+      __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl"))
+    return "SkylakeX";
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return "Haswell";
+#endif
+  return nullptr;
+}
+
+void ChooseBlasKernels() {
+  if (!openblas_get_corename || !gotoblas_dynamic_init || !gotoblas_dynamic_quit) return;
+  if (std::getenv("OPENBLAS_CORETYPE") != nullptr) return;  // the user's choice stands
+  const char* core = openblas_get_corename();
+  if (core == nullptr || std::strcmp(core, "Prescott") != 0) return;
+  const char* better = BetterBlasCore();
+  if (better == nullptr) return;
+  setenv("OPENBLAS_CORETYPE", better, 0);
+  gotoblas_dynamic_quit();
+  gotoblas_dynamic_init();
+}
+
 const bool kBlasOnOneThread = [] {
+  ChooseBlasKernels();
   if (openblas_set_num_threads) openblas_set_num_threads(1);
   return true;
 }();
@@ -29,6 +68,12 @@ const bool kBlasOnOneThread = [] {
 }  // namespace
 
 bool BlasIsSingleThreaded() { return kBlasOnOneThread; }
+
+std::string BlasCoreName() {
+  if (!openblas_get_corename) return "";
+  const char* core = openblas_get_corename();
+  return core != nullptr ? core : "";
+}
 
 void Gemv(const Eigen::MatrixXf& a, const Eigen::VectorXf& x, Eigen::VectorXf* y) {
   const Eigen::Index m = a.rows();

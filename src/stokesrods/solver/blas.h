@@ -2,6 +2,8 @@
 // x86-64, where Eigen's own products use SSE2 only; these are the products that matter.
 #pragma once
 
+#include <string>
+
 #include <Eigen/Core>
 
 namespace stokesrods {
@@ -10,6 +12,10 @@ namespace stokesrods {
 /// blas.cc: results must not depend on the thread count). Callers of the BLAS reference it so
 /// that the setting is linked in.
 bool BlasIsSingleThreaded();
+/// OpenBLAS's kernel set in use ("SkylakeX", "Haswell", "Zen", …; empty with another BLAS). On a
+/// CPU it does not know, OpenBLAS would take its SSE3 fallback; blas.cc then chooses by the CPU's
+/// features, unless OPENBLAS_CORETYPE is set.
+std::string BlasCoreName();
 
 /// y = A x (y resized), rows in blocks over the OpenMP threads (the BLAS itself runs on one).
 void Gemv(const Eigen::MatrixXf& a, const Eigen::VectorXf& x, Eigen::VectorXf* y);
