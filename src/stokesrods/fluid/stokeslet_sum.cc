@@ -1,9 +1,12 @@
 // The direct sum of regularized Stokeslets and its vectorized inner loop (point_stokeslet.h). The
 // fast sum is the kernel-independent FMM of fmm_sum.cc.
 //
-// MEASURED (AMD EPYC, one thread, 1280 sources × 650 targets): the direct sum on AVX-512
-// intrinsics costs 0.46 ns per pair in double and 0.18 ns in single precision (the compiler's
-// vectorization of the portable loops, kept for CPUs without AVX-512: 1.6 and 0.22 ns).
+// MEASURED (one thread): on an AMD EPYC (1280 sources × 650 targets, one target at a time) the
+// direct sum on AVX-512 intrinsics cost 0.46 ns per pair in double and 0.18 ns in single
+// precision (the compiler's vectorization of the portable loops, kept for CPUs without AVX-512:
+// 1.6 and 0.22 ns); on an Intel Xeon (Emerald Rapids; 2560 × 1300, BM_StokesletSumApply/20/4/0)
+// 0.52 ns in single precision one target at a time with the IEEE square root, 0.38 ns four at a
+// time with rsqrt14.
 #include "stokesrods/fluid/stokeslet_sum.h"
 
 #include <algorithm>
@@ -105,15 +108,19 @@ void PointSumBlocksPortable(const SourceColumnsF& c, const SourceRange* ranges, 
 namespace {
 
 #if defined(__x86_64__)
-// The sums written with AVX-512 intrinsics: the same arithmetic as the portable loops (IEEE
-// square root and division, no approximate reciprocal) with fused multiply–adds and the lanes kept
-// in registers, except that 1/R³ is 1/R² (the division) times 1/R = √(1/R²): one multiplication
-// fewer per pair than cubing 1/R, in a loop bound by the multiply–add pipes (lattice of 100
-// helices, FMM Apply at p = 4, one thread: −5 %). GCC 12 vectorizes the portable loops into code 18 % slower in single precision and
-// 3.5× slower in double (measured, AMD EPYC, one thread, 1280 sources × 650 targets: 0.182
-// against 0.222 and 0.456 against 1.61 ns per pair). Any ranges: a block that runs past a range's
-// end is masked, its missing lanes read as a source at distance ≥ 1 of zero strength (they add
-// exactly zero).
+// The sums written with AVX-512 intrinsics: the arithmetic of the portable loops with fused
+// multiply–adds and the lanes kept in registers, and
+//   - 1/R³ as 1/R times 1/R², one multiplication fewer per pair than cubing 1/R;
+//   - in double, 1/R = √(1/R²) by the IEEE division and square root; in single precision by the
+//     14-bit estimate rsqrt14 and one Newton step (≈ 3 ulp): the IEEE division and square root
+//     bounded the loop on an Intel Xeon (20 helices, direct sum, one thread: 1.83 → 1.61 ms),
+//     and cost nothing there on an AMD EPYC (session 12: within the noise);
+//   - up to kPointSumTargets targets per pass over the sources (PointSumRanges512<K>).
+// GCC 12 vectorizes the portable loops into code 18 % slower in single precision and 3.5× slower
+// in double (measured, AMD EPYC, one thread, 1280 sources × 650 targets: 0.182 against 0.222 and
+// 0.456 against 1.61 ns per pair, before the targets were taken together). Any ranges: a block
+// that runs past a range's end is masked, its missing lanes read as a source at distance ≥ 1 of
+// zero strength (they add exactly zero).
 #define SR_AVX512 __attribute__((target("avx512f"), always_inline)) static inline
 
 // 16 floats or 8 doubles per vector.
