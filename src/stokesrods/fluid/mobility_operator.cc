@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 
 #include "stokesrods/common/assert.h"
+#include "stokesrods/fluid/far_rule_sum.h"
 #include "stokesrods/fluid/near_search.h"
 #include "stokesrods/fluid/rss.h"
 #include "stokesrods/fluid/rss_rows.h"
@@ -148,7 +149,9 @@ class MatrixFreeRssMobility final : public MobilityOperator {
         far_(MakeFastStokesletSum(
             {.tolerance = options.fast_sum_tolerance,
              .direct_below_pairs = static_cast<std::int64_t>(options.direct_sum_below),
-             .choose_by_cost = options.fast_sum_by_cost})) {
+             .choose_by_cost = options.fast_sum_by_cost})),
+        far_rule_by_distance_(options.far_rule_by_distance),
+        single_far_(options.fast_sum_tolerance >= kSinglePrecisionTolerance) {
     SR_ASSERT(!params.wall, "the matrix-free RSS is the free-space operator: a wall's images wrap "
                             "it (MakeMobilityWithWallImages, fluid/wall_sources.h)");
   }
@@ -163,7 +166,8 @@ class MatrixFreeRssMobility final : public MobilityOperator {
   }
   void FindNearBlocks(const Matrix3X& targets, NearBlocks* blocks) const override;
   MobilityCostCounts cost_counts() const override {
-    return {static_cast<std::int64_t>(near_.block.size()), far_->Stats().cost, split_.gauss_points};
+    const double far_cost = use_rule_sum_ ? static_cast<double>(rule_sum_.pairs()) : far_->Stats().cost;
+    return {static_cast<std::int64_t>(near_.block.size()), far_cost, split_.gauss_points};
   }
 
  private:
@@ -185,6 +189,9 @@ class MatrixFreeRssMobility final : public MobilityOperator {
   void NearPairBlocks(const Vec3& p, const std::vector<int>& near,
                       const std::vector<RssRowKernel>& kernels, NearRowScratch* scratch,
                       std::vector<std::pair<int, Mat3>>* blocks) const;
+  // Per segment its first node and ε; per rod its first segment (and the total last).
+  void SegmentLists(std::vector<int>* first_node, VecX* eps,
+                    std::vector<int>* rod_first_segment) const;
 
   FluidParams params_;
   double accuracy_;                 // of the far field, its quadrature and the near pairs
@@ -193,6 +200,12 @@ class MatrixFreeRssMobility final : public MobilityOperator {
   bool split_by_cost_;
   bool choose_split_ = true;        // at the next Update (the first, then after ForgetHistory)
   std::unique_ptr<StokesletSum> far_;
+  // Where far_ sums directly and the split has more than 2 points: the far field with fewer
+  // points on the rods far from each group of targets (fluid/far_rule_sum.h), used instead.
+  bool far_rule_by_distance_;
+  bool single_far_;                 // the far sum in single precision (kSinglePrecisionTolerance)
+  bool use_rule_sum_ = false;
+  FarRuleSum rule_sum_;
   std::vector<HydroRod> rods_;
   Matrix3X nodes_;                  // 3 × M
   VecX inverse_voronoi_;            // 1/Λ_j
@@ -202,7 +215,7 @@ class MatrixFreeRssMobility final : public MobilityOperator {
   NearBlocks near_;                 // the near corrections at the nodes
   // FindNearBlocks' blocks per target before they are packed (kept: their capacity is reused).
   mutable std::vector<std::vector<std::pair<int, Mat3>>> per_target_;
-  mutable Matrix3X strengths_, far_velocity_;
+  mutable Matrix3X strengths_, far_velocity_, density_;
 };
 
 void MatrixFreeRssMobility::Update(const std::vector<HydroRod>& rods) {
@@ -269,16 +282,32 @@ void MatrixFreeRssMobility::BuildSplit() {
   }
   far_->Build(gauss_points_, gauss_eps_, nodes_);
   FindNearBlocks(nodes_, &near_);
+  const StokesletSumStats far = far_->Stats();
+  use_rule_sum_ = far_rule_by_distance_ && g > 2 && far.far_pairs == 0;
+  if (use_rule_sum_) {
+    std::vector<int> first_node, rod_first_segment;
+    VecX eps;
+    SegmentLists(&first_node, &eps, &rod_first_segment);
+    rule_sum_.Build(nodes_, first_node, eps, rod_first_segment, g, accuracy_, single_far_);
+  }
 }
 
 // The near pairs by NearSegmentSearch (fluid/near_search.h: boxes per rod and per run of
 // consecutive segments grown by the near reach), their blocks by NearPairBlocks.
-void MatrixFreeRssMobility::FindNearBlocks(const Matrix3X& targets, NearBlocks* out) const {
-  std::vector<int> first_node(segments_.size()), rod_first_segment;
-  VecX eps(static_cast<Eigen::Index>(segments_.size()));
+void MatrixFreeRssMobility::SegmentLists(std::vector<int>* first_node, VecX* eps,
+                                         std::vector<int>* rod_first_segment) const {
+  first_node->resize(segments_.size());
+  eps->resize(static_cast<Eigen::Index>(segments_.size()));
   for (std::size_t s = 0; s < segments_.size(); ++s)
-    first_node[s] = segments_[s].a, eps(static_cast<Eigen::Index>(s)) = segments_[s].eps;
-  for (int r = 0; r <= num_rods(); ++r) rod_first_segment.push_back(node_offset(r) - r);
+    (*first_node)[s] = segments_[s].a, (*eps)(static_cast<Eigen::Index>(s)) = segments_[s].eps;
+  rod_first_segment->clear();
+  for (int r = 0; r <= num_rods(); ++r) rod_first_segment->push_back(node_offset(r) - r);
+}
+
+void MatrixFreeRssMobility::FindNearBlocks(const Matrix3X& targets, NearBlocks* out) const {
+  std::vector<int> first_node, rod_first_segment;
+  VecX eps;
+  SegmentLists(&first_node, &eps, &rod_first_segment);
   NearSegmentSearch search;
   search.Build(nodes_, first_node, eps, rod_first_segment, split_.near_delta);
   std::vector<RssRowKernel> kernels;
@@ -359,21 +388,26 @@ void MatrixFreeRssMobility::NearPairBlocks(const Vec3& p, const std::vector<int>
 void MatrixFreeRssMobility::Apply(const VecX& force, VecX* velocity) const {
   const auto m = static_cast<int>(nodes_.cols());
   SR_ASSERT(force.size() == 3 * m, "mobility: force vector of the wrong size");
-  const int g = split_.gauss_points;
-  const double* alpha = nullptr;
-  const double* weight = nullptr;
-  GaussLegendreRule01(g, &alpha, &weight);
-  strengths_.resize(3, gauss_points_.cols());
-  for (std::size_t s = 0; s < segments_.size(); ++s) {
-    const int a = segments_[s].a;
-    const double length = (nodes_.col(a + 1) - nodes_.col(a)).norm();
-    const Vec3 fa = force.segment<3>(3 * a) * inverse_voronoi_(a);
-    const Vec3 fb = force.segment<3>(3 * (a + 1)) * inverse_voronoi_(a + 1);
-    for (int q = 0; q < g; ++q)
-      strengths_.col(static_cast<Eigen::Index>(s) * g + q) =
-          (weight[q] * length) * ((1.0 - alpha[q]) * fa + alpha[q] * fb);
+  if (use_rule_sum_) {
+    density_ = force.reshaped(3, m).array().rowwise() * inverse_voronoi_.transpose().array();
+    rule_sum_.Apply(density_, &far_velocity_);
+  } else {
+    const int g = split_.gauss_points;
+    const double* alpha = nullptr;
+    const double* weight = nullptr;
+    GaussLegendreRule01(g, &alpha, &weight);
+    strengths_.resize(3, gauss_points_.cols());
+    for (std::size_t s = 0; s < segments_.size(); ++s) {
+      const int a = segments_[s].a;
+      const double length = (nodes_.col(a + 1) - nodes_.col(a)).norm();
+      const Vec3 fa = force.segment<3>(3 * a) * inverse_voronoi_(a);
+      const Vec3 fb = force.segment<3>(3 * (a + 1)) * inverse_voronoi_(a + 1);
+      for (int q = 0; q < g; ++q)
+        strengths_.col(static_cast<Eigen::Index>(s) * g + q) =
+            (weight[q] * length) * ((1.0 - alpha[q]) * fa + alpha[q] * fb);
+    }
+    far_->Apply(strengths_, &far_velocity_);
   }
-  far_->Apply(strengths_, &far_velocity_);
   velocity->resize(3 * m);
   const double scale = 1.0 / (8.0 * kPi * params_.viscosity);
 #pragma omp parallel for schedule(static)

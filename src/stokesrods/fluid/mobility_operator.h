@@ -79,6 +79,11 @@ struct MobilityOptions {
   /// more Gauss point (and its smaller near zone) replaces that one where the estimated cost of a
   /// step is lower (mobility_operator.cc); false keeps ChooseNearFarSplit's (tests) [–].
   bool split_by_cost = true;
+  /// Matrix-free, where the far sum is direct and the split takes more than 2 Gauss points: each
+  /// rod far enough from a group of targets is summed there with fewer points, as few as meet the
+  /// same tolerance at that distance (fluid/far_rule_sum.h); false: the split's points on every
+  /// rod (tests, the reference) [–].
+  bool far_rule_by_distance = true;
   /// Dense: 𝕄 reused across Updates (time steps) by extrapolation while its measured relative
   /// error stays below this (fluid/mobility_reuse.h); 0 assembles at every Update [–].
   double reuse_tolerance = 0.0;

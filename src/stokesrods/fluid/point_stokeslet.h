@@ -62,6 +62,12 @@ void AddPointSumSingleTargets(const SourceColumnsF& c, Eigen::Index begin, Eigen
                               int n, const float* const* x, double* const* w);
 void AddPointSumBlocksTargets(const SourceColumnsF& c, const SourceRange* ranges, int count,
                               int n, const float* const* x, double* const* w);
+/// The same over several ranges of any length (each masked at its end on AVX-512): the lanes are
+/// reduced once per target for all ranges. Without AVX-512, range by range.
+void AddPointSumRangesTargets(const SourceColumns& c, const SourceRange* ranges, int count, int n,
+                              const double* const* x, double* const* w);
+void AddPointSumRangesTargets(const SourceColumnsF& c, const SourceRange* ranges, int count, int n,
+                              const float* const* x, double* const* w);
 
 /// The compiler-vectorized loops behind AddPointSum, AddPointSumSingle and AddPointSumBlocks on
 /// CPUs without AVX-512 (there the sums run on intrinsics; the tests check both paths).

@@ -274,6 +274,27 @@ void AddPointSumSingleTargets(const SourceColumnsF& c, Eigen::Index begin, Eigen
   PointSumTargets512(c, &range, 1, n, x, w);
 }
 
+void AddPointSumRangesTargets(const SourceColumns& c, const SourceRange* ranges, int count, int n,
+                              const double* const* x, double* const* w) {
+  if (!HasAvx512()) {
+    for (int k = 0; k < n; ++k)
+      for (int r = 0; r < count; ++r) PointSumPortable(c, ranges[r].begin, ranges[r].end, x[k], w[k]);
+    return;
+  }
+  PointSumTargets512(c, ranges, count, n, x, w);
+}
+
+void AddPointSumRangesTargets(const SourceColumnsF& c, const SourceRange* ranges, int count, int n,
+                              const float* const* x, double* const* w) {
+  if (!HasAvx512()) {
+    for (int k = 0; k < n; ++k)
+      for (int r = 0; r < count; ++r)
+        PointSumSinglePortable(c, ranges[r].begin, ranges[r].end, x[k], w[k]);
+    return;
+  }
+  PointSumTargets512(c, ranges, count, n, x, w);
+}
+
 void AddPointSumBlocksTargets(const SourceColumnsF& c, const SourceRange* ranges, int count,
                               int n, const float* const* x, double* const* w) {
   if (!HasAvx512()) {

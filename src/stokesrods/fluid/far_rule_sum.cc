@@ -1,0 +1,159 @@
+#include "stokesrods/fluid/far_rule_sum.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+#include "stokesrods/common/assert.h"
+#include "stokesrods/fluid/mobility_operator.h"
+#include "stokesrods/fluid/stokeslet_segment.h"
+
+namespace stokesrods {
+
+void FarRuleSum::Build(const Matrix3X& nodes, const std::vector<int>& first_node, const VecX& eps,
+                       const std::vector<int>& rod_first_segment, int points, double accuracy,
+                       bool single) {
+  SR_ASSERT(points >= 2, "the far rule needs at least 2 points");
+  const int segments = static_cast<int>(first_node.size());
+  const int rods = static_cast<int>(rod_first_segment.size()) - 1;
+  single_ = single;
+  first_node_ = first_node;
+  targets_ = nodes;
+
+  // The rules k = 2 … n, their points on every segment one after the other.
+  rules_.clear();
+  int sources = 0;
+  for (int k = 2; k <= points; ++k) {
+    Rule rule{.points = k, .first_source = sources};
+    GaussLegendreRule01(k, &rule.alpha, &rule.weight);
+    rules_.push_back(rule);
+    sources += k * segments;
+  }
+  src_.resize(sources, 7);
+  length_.resize(segments);
+  for (int s = 0; s < segments; ++s)
+    length_(s) = (nodes.col(first_node[static_cast<size_t>(s)] + 1) - nodes.col(first_node[static_cast<size_t>(s)])).norm();
+  for (const Rule& rule : rules_)
+    for (int s = 0; s < segments; ++s) {
+      const Vec3 xa = nodes.col(first_node[static_cast<size_t>(s)]);
+      const Vec3 v = nodes.col(first_node[static_cast<size_t>(s)] + 1) - xa;
+      for (int q = 0; q < rule.points; ++q) {
+        const int row = rule.first_source + s * rule.points + q;
+        src_.row(row).head<3>() = (xa + rule.alpha[q] * v).transpose();
+        src_(row, 3) = eps(s) * eps(s);
+      }
+    }
+  const Vec3 origin = nodes.cols() > 0 ? Vec3(nodes.rowwise().mean()) : Vec3::Zero();
+  if (single_) {
+    src_f_ = src_.cast<float>();
+    src_f_.leftCols<3>() = (src_.leftCols<3>().rowwise() - origin.transpose()).cast<float>();
+    targets_f_ = (nodes.colwise() - origin).cast<float>();
+  }
+
+  // Per chunk of kChunkSegments consecutive segments of a rod: its box and its longest segment
+  // (a rod's segments differ: a clamp's lead is longer than the helix's).
+  std::vector<int> chunk_first;  // first segment of each chunk, then the total
+  for (int r = 0; r < rods; ++r)
+    for (int s = rod_first_segment[static_cast<size_t>(r)]; s < rod_first_segment[static_cast<size_t>(r) + 1];
+         s += kChunkSegments)
+      chunk_first.push_back(s);
+  const int chunks = static_cast<int>(chunk_first.size());
+  chunk_first.push_back(segments);
+  std::vector<int> chunk_end(static_cast<size_t>(chunks));
+  std::vector<Eigen::AlignedBox3d> chunk_box(static_cast<size_t>(chunks));
+  std::vector<double> longest2(static_cast<size_t>(chunks), 0.0);
+  for (int r = 0, c = 0; r < rods; ++r)
+    for (; c < chunks && chunk_first[static_cast<size_t>(c)] < rod_first_segment[static_cast<size_t>(r) + 1]; ++c) {
+      const auto k = static_cast<size_t>(c);
+      chunk_end[k] = std::min(chunk_first[k] + kChunkSegments, rod_first_segment[static_cast<size_t>(r) + 1]);
+      for (int s = chunk_first[k]; s < chunk_end[k]; ++s) {
+        const int a = first_node[static_cast<size_t>(s)];
+        chunk_box[k].extend(Vec3(nodes.col(a)));
+        chunk_box[k].extend(Vec3(nodes.col(a + 1)));
+        longest2[k] = std::max(longest2[k], length_(s) * length_(s));
+      }
+    }
+  std::vector<double> radius2(rules_.size());  // NearRadius(k)², k = 2 … n
+  for (std::size_t i = 0; i < rules_.size(); ++i)
+    radius2[i] = std::pow(NearRadius(rules_[i].points, accuracy), 2);
+
+  // Per group of targets, per chunk: the fewest points whose reach the group's box clears.
+  const int m = static_cast<int>(nodes.cols());
+  const int groups = (m + kGroupTargets - 1) / kGroupTargets;
+  range_start_.assign(1, 0);
+  range_.clear();
+  pairs_ = pairs_at_n_ = 0;
+  for (int g = 0; g < groups; ++g) {
+    const int first = g * kGroupTargets, count = std::min(kGroupTargets, m - first);
+    Eigen::AlignedBox3d box;
+    for (int t = first; t < first + count; ++t) box.extend(Vec3(nodes.col(t)));
+    for (int c = 0; c < chunks; ++c) {
+      const auto k = static_cast<size_t>(c);
+      const double d2 = chunk_box[k].squaredExteriorDistance(box);
+      std::size_t i = 0;  // the fewest points that serve; n when none of fewer does
+      while (i + 1 < rules_.size() && d2 < radius2[i] * longest2[k]) ++i;
+      const Rule& rule = rules_[i];
+      const SourceRange range{rule.first_source + chunk_first[k] * rule.points,
+                              rule.first_source + chunk_end[k] * rule.points};
+      // Consecutive chunks on the same rule are one range.
+      if (range_.size() > static_cast<size_t>(range_start_.back()) && range_.back().end == range.begin)
+        range_.back().end = range.end;
+      else
+        range_.push_back(range);
+      pairs_ += static_cast<std::int64_t>(count) * (chunk_end[k] - chunk_first[k]) * rule.points;
+      pairs_at_n_ += static_cast<std::int64_t>(count) * (chunk_end[k] - chunk_first[k]) * points;
+    }
+    range_start_.push_back(static_cast<int>(range_.size()));
+  }
+}
+
+void FarRuleSum::FillStrengths(const Matrix3X& density) const {
+  const int segments = static_cast<int>(first_node_.size());
+  for (const Rule& rule : rules_) {
+#pragma omp parallel for schedule(static)
+    for (int s = 0; s < segments; ++s) {
+      const Vec3 fa = density.col(first_node_[static_cast<size_t>(s)]);
+      const Vec3 fb = density.col(first_node_[static_cast<size_t>(s)] + 1);
+      for (int q = 0; q < rule.points; ++q) {
+        const Vec3 g = (rule.weight[q] * length_(s)) * ((1.0 - rule.alpha[q]) * fa + rule.alpha[q] * fb);
+        const int row = rule.first_source + s * rule.points + q;
+        src_.row(row).tail<3>() = g.transpose();
+        if (single_) src_f_.row(row).tail<3>() = g.transpose().cast<float>();
+      }
+    }
+  }
+}
+
+void FarRuleSum::Apply(const Matrix3X& density, Matrix3X* w) const {
+  SR_ASSERT(density.cols() == targets_.cols(), "far rule sum: one density per node");
+  FillStrengths(density);
+  const int m = static_cast<int>(targets_.cols());
+  w->setZero(3, m);
+  const SourceColumns columns = Columns(src_);
+  const SourceColumnsF columns_f = single_ ? ColumnsF(src_f_) : SourceColumnsF{};
+  const int groups = static_cast<int>(range_start_.size()) - 1;
+#pragma omp parallel for schedule(static)
+  for (int g = 0; g < groups; ++g) {
+    const int end = std::min(m, (g + 1) * kGroupTargets);
+    for (int t0 = g * kGroupTargets; t0 < end; t0 += kPointSumTargets) {
+      const int n = std::min(kPointSumTargets, end - t0);
+      double* out[kPointSumTargets];
+      const double* x[kPointSumTargets];
+      const float* xf[kPointSumTargets];
+      for (int k = 0; k < n; ++k) {
+        out[k] = w->col(t0 + k).data();
+        x[k] = targets_.col(t0 + k).data();
+        if (single_) xf[k] = targets_f_.col(t0 + k).data();
+      }
+      const SourceRange* ranges = range_.data() + range_start_[static_cast<size_t>(g)];
+      const int count = range_start_[static_cast<size_t>(g) + 1] - range_start_[static_cast<size_t>(g)];
+      if (single_)
+        AddPointSumRangesTargets(columns_f, ranges, count, n, xf, out);
+      else
+        AddPointSumRangesTargets(columns, ranges, count, n, x, out);
+    }
+  }
+}
+
+}  // namespace stokesrods

@@ -1,0 +1,75 @@
+// The far field of the matrix-free RSS mobility (mobility_operator.cc) summed directly, with for
+// each group of targets and each source rod the fewest Gauss points per segment that meet the
+// tolerance there.
+//
+// The operator's split takes n points on every segment and the closed forms on segments nearer
+// than NearRadius(n) of their lengths. The k-point rule (2 ≤ k < n) meets the same tolerance from
+// NearRadius(k) segment lengths on (GaussRuleError), so a rod whose every segment lies that far
+// from a group of targets is summed there with k points; the same holds chunk by chunk of a rod's
+// consecutive segments. With δ = √(d² + ε²)/|v| (d from a target to the segment), it is enough that
+//     d_box² ≥ NearRadius(k)² max_s |v_s|²,
+// d_box the distance between the group's bounding box and the chunk's (which holds its segments;
+// leaving ε² out makes the test conservative), the maximum over the chunk's segments.
+// Near segments (δ < NearRadius(n)) only occur in chunks that fail this test for every k < n, so
+// they keep the n-point rule that the near corrections subtract. Ten helices on a ring 3R apart
+// take n = 3 (ChooseSplitByCost), and most of the other rods' chunks are far enough for 2.
+// Used where the far sum is direct (the FMM sums one set of points, and its tree replaces the
+// distant pairs anyway).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "stokesrods/common/types.h"
+#include "stokesrods/fluid/point_stokeslet.h"
+
+namespace stokesrods {
+
+class FarRuleSum {
+ public:
+  /// Consecutive targets taken as one group, and consecutive segments of a rod as one chunk: the
+  /// distance between their bounding boxes decides the chunk's rule at the group's targets.
+  static constexpr int kGroupTargets = 16;
+  static constexpr int kChunkSegments = 16;
+
+  /// Segment s runs from nodes.col(first_node[s]) to the next column, with blob size eps[s]; rod
+  /// r's segments are [rod_first_segment[r], rod_first_segment[r + 1]). points: the split's n
+  /// (≥ 2); accuracy: its tolerance (NearRadius); single: kernel sums in single precision
+  /// (kSinglePrecisionTolerance). The targets are the nodes.
+  void Build(const Matrix3X& nodes, const std::vector<int>& first_node, const VecX& eps,
+             const std::vector<int>& rod_first_segment, int points, double accuracy, bool single);
+
+  /// w (3 × M) = Σ_segments Σ_q w_q L S_ε(x_t − y_q) ((1 − α_q) f_a + α_q f_b), each rod with the
+  /// rule Build chose for the target's group; density: the nodal force densities f (3 × M).
+  void Apply(const Matrix3X& density, Matrix3X* w) const;
+
+  /// Kernel evaluations per Apply; the same sum with n points everywhere would take
+  /// pairs_at_n() (for the tests and the bench).
+  std::int64_t pairs() const { return pairs_; }
+  std::int64_t pairs_at_n() const { return pairs_at_n_; }
+
+ private:
+  struct Rule {
+    int points = 0;
+    int first_source = 0;  // its point q of segment s is source first_source + s × points + q
+    const double* alpha = nullptr;
+    const double* weight = nullptr;
+  };
+  void FillStrengths(const Matrix3X& density) const;
+
+  bool single_ = false;
+  std::vector<Rule> rules_;       // k = 2 … n
+  std::vector<int> first_node_;   // per segment
+  VecX length_;                   // per segment
+  Matrix3X targets_;
+  Eigen::Matrix3Xf targets_f_;    // relative to origin_
+  mutable MatX src_;              // sources × 7 (x, y, z, ε², g): the strengths of the last Apply
+  mutable Eigen::MatrixXf src_f_; // the same in single precision, positions relative to origin_
+  // Per group g of targets [g kGroupTargets, …): its source ranges range_[range_start_[g] …),
+  // each one or more consecutive chunks on one rule.
+  std::vector<int> range_start_;
+  std::vector<SourceRange> range_;
+  std::int64_t pairs_ = 0, pairs_at_n_ = 0;
+};
+
+}  // namespace stokesrods
