@@ -393,7 +393,8 @@ TEST(StokesletSumTest, SingleKernelOverAnyRangeMatchesThePlainSum) {
 
 // The sums at several targets at once (one read of each block of sources for all of them)
 // against the one-target sums, for 1 … kPointSumTargets targets, in double, in float and over
-// ranges of whole blocks: bit for bit, since each target's arithmetic and order are the same.
+// ranges of whole blocks: bit for bit, since each target's arithmetic and order are the same;
+// and over ranges of any length together (AddPointSumRangesTargets).
 TEST(StokesletSumTest, SeveralTargetsAtOnceEqualEachTargetAlone) {
   std::mt19937 rng(8);
   std::uniform_real_distribution<double> unit(-0.1, 0.1);
@@ -424,6 +425,30 @@ TEST(StokesletSumTest, SeveralTargetsAtOnceEqualEachTargetAlone) {
     EXPECT_GT(alone.cwiseAbs().minCoeff(), 0.0);
     for (Eigen::Index k = 0; k < together.size(); ++k)
       EXPECT_EQ(together.data()[k], alone.data()[k]) << n << " targets, entry " << k;
+    // Ranges of any length summed together: bit for bit one target alone over the same ranges,
+    // and the sum of the ranges one by one to the rounding of the reduction.
+    const std::vector<SourceRange> odd = {{1, 20}, {33, 50}, {52, static_cast<int>(src.rows())}};
+    Matrix3X ranged = Matrix3X::Zero(3, 2 * n), ranged_alone = ranged, by_range = ranged;
+    double* ranged_out[2][kPointSumTargets];
+    for (int k = 0; k < n; ++k) {
+      ranged_out[0][k] = ranged.col(k).data(), ranged_out[1][k] = ranged.col(n + k).data();
+      double* one_d[1] = {ranged_alone.col(k).data()};
+      double* one_f[1] = {ranged_alone.col(n + k).data()};
+      AddPointSumRangesTargets(Columns(src), odd.data(), 3, 1, &xd[k], one_d);
+      AddPointSumRangesTargets(ColumnsF(src_f), odd.data(), 3, 1, &xs[k], one_f);
+      for (const SourceRange& r : odd) {
+        AddPointSum(Columns(src), r.begin, r.end, xd[k], by_range.col(k).data());
+        AddPointSumSingle(ColumnsF(src_f), r.begin, r.end, xs[k], by_range.col(n + k).data());
+      }
+    }
+    AddPointSumRangesTargets(Columns(src), odd.data(), 3, n, xd, ranged_out[0]);
+    AddPointSumRangesTargets(ColumnsF(src_f), odd.data(), 3, n, xs, ranged_out[1]);
+    for (Eigen::Index k = 0; k < ranged.size(); ++k)
+      EXPECT_EQ(ranged.data()[k], ranged_alone.data()[k]) << n << " targets, entry " << k;
+    EXPECT_LT((ranged.leftCols(n) - by_range.leftCols(n)).cwiseAbs().maxCoeff(),
+              1e-13 * by_range.leftCols(n).cwiseAbs().maxCoeff());
+    EXPECT_LT((ranged.rightCols(n) - by_range.rightCols(n)).cwiseAbs().maxCoeff(),
+              1e-6 * by_range.rightCols(n).cwiseAbs().maxCoeff());
   }
 }
 
