@@ -6,7 +6,7 @@
 // precision (the compiler's vectorization of the portable loops, kept for CPUs without AVX-512:
 // 1.6 and 0.22 ns); on an Intel Xeon (Emerald Rapids; 2560 × 1300, BM_StokesletSumApply/20/4/0)
 // 0.52 ns in single precision one target at a time with the IEEE square root, 0.38 ns four at a
-// time with rsqrt14.
+// time with rsqrt14; in double 1.76 and 0.9 ns.
 #include "stokesrods/fluid/stokeslet_sum.h"
 
 #include <algorithm>
@@ -111,10 +111,11 @@ namespace {
 // The sums written with AVX-512 intrinsics: the arithmetic of the portable loops with fused
 // multiply–adds and the lanes kept in registers, and
 //   - 1/R³ as 1/R times 1/R², one multiplication fewer per pair than cubing 1/R;
-//   - in double, 1/R = √(1/R²) by the IEEE division and square root; in single precision by the
-//     14-bit estimate rsqrt14 and one Newton step (≈ 3 ulp): the IEEE division and square root
-//     bounded the loop on an Intel Xeon (20 helices, direct sum, one thread: 1.83 → 1.61 ms),
-//     and cost nothing there on an AMD EPYC (session 12: within the noise);
+//   - 1/R by the 14-bit estimate rsqrt14 and Newton steps instead of the IEEE division and
+//     square root: one step in single precision (≈ 3 ulp), two in double (≈ 1 ulp). The IEEE
+//     operations bounded the loops on an Intel Xeon (20 helices, direct sum, one thread: float
+//     1.83 → 1.61 ms; double, at 1e-6, 5.9 → 3.1 ms with four targets at once), and cost
+//     nothing measurable in float on an AMD EPYC (session 12);
 //   - up to kPointSumTargets targets per pass over the sources (PointSumRanges512<K>).
 // GCC 12 vectorizes the portable loops into code 18 % slower in single precision and 3.5× slower
 // in double (measured, AMD EPYC, one thread, 1280 sources × 650 targets: 0.182 against 0.222 and
@@ -160,7 +161,17 @@ struct Avx512<double> {
   SR_AVX512 V Fma(V a, V b, V c) { return _mm512_fmadd_pd(a, b, c); }
   SR_AVX512 V Inverse(V a) { return _mm512_div_pd(Set(1.0), a); }
   SR_AVX512 V Sqrt(V a) { return _mm512_sqrt_pd(a); }
-  SR_AVX512 V InverseSqrt(V a) { return Sqrt(Inverse(a)); }
+  // 1/√a by the 14-bit estimate and two Newton steps y + y (1 − a y²)/2, the bracket by a fused
+  // multiply–add (≈ 1 ulp; the division and square root took ≈ 40 cycles per 8 lanes on an Intel
+  // Xeon, where the double sum ran at 1.7 ns per pair).
+  SR_AVX512 V InverseSqrt(V a) {
+    V y = _mm512_rsqrt14_pd(a);
+    for (int step = 0; step < 2; ++step) {
+      const V r = _mm512_fnmadd_pd(_mm512_mul_pd(a, y), y, Set(1.0));
+      y = _mm512_fmadd_pd(_mm512_mul_pd(y, r), Set(0.5), y);
+    }
+    return y;
+  }
   SR_AVX512 double Sum(V a) { return _mm512_reduce_add_pd(a); }
 };
 
