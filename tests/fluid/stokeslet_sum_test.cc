@@ -419,8 +419,9 @@ TEST(StokesletSumTest, SeveralTargetsAtOnceEqualEachTargetAlone) {
       AddPointSumBlocks(ColumnsF(src_f), ranges.data(), 2, xf.col(k).data(),
                         alone.col(2 * n + k).data());
     }
-    AddPointSumTargets(Columns(src), begin, end, n, xd, out[0]);
-    AddPointSumSingleTargets(ColumnsF(src_f), begin, end, n, xs, out[1]);
+    const SourceRange part{static_cast<int>(begin), static_cast<int>(end)};
+    AddPointSumRangesTargets(Columns(src), &part, 1, n, xd, out[0]);
+    AddPointSumRangesTargets(ColumnsF(src_f), &part, 1, n, xs, out[1]);
     AddPointSumBlocksTargets(ColumnsF(src_f), ranges.data(), 2, n, xs, out[2]);
     EXPECT_GT(alone.cwiseAbs().minCoeff(), 0.0);
     for (Eigen::Index k = 0; k < together.size(); ++k)

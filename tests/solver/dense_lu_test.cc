@@ -131,8 +131,7 @@ TEST(Blas, RunsOnOneThreadOfItsOwn) {
 TEST(Blas, DoesNotRunTheOldestKernelsOnANewerCpu) {
   const std::string core = BlasCoreName();
   if (core.empty()) GTEST_SKIP() << "not OpenBLAS";
-  if (std::getenv("OPENBLAS_CORETYPE") != nullptr && std::string(std::getenv("OPENBLAS_CORETYPE")) != core)
-    GTEST_SKIP() << "OPENBLAS_CORETYPE set by the user";
+  if (std::getenv("OPENBLAS_CORETYPE") != nullptr) GTEST_SKIP() << "OPENBLAS_CORETYPE set by the user";
 #if defined(__x86_64__)
   if (!__builtin_cpu_supports("avx2") || !__builtin_cpu_supports("fma"))
     GTEST_SKIP() << "no AVX2 here";

@@ -53,13 +53,12 @@ void FarRuleSum::Build(const Matrix3X& nodes, const std::vector<int>& first_node
 
   // Per chunk of kChunkSegments consecutive segments of a rod: its box and its longest segment
   // (a rod's segments differ: a clamp's lead is longer than the helix's).
-  std::vector<int> chunk_first;  // first segment of each chunk, then the total
+  std::vector<int> chunk_first;  // first segment of each chunk
   for (int r = 0; r < rods; ++r)
     for (int s = rod_first_segment[static_cast<size_t>(r)]; s < rod_first_segment[static_cast<size_t>(r) + 1];
          s += kChunkSegments)
       chunk_first.push_back(s);
   const int chunks = static_cast<int>(chunk_first.size());
-  chunk_first.push_back(segments);
   std::vector<int> chunk_end(static_cast<size_t>(chunks));
   std::vector<Eigen::AlignedBox3d> chunk_box(static_cast<size_t>(chunks));
   std::vector<double> longest2(static_cast<size_t>(chunks), 0.0);
@@ -110,18 +109,19 @@ void FarRuleSum::Build(const Matrix3X& nodes, const std::vector<int>& first_node
 
 void FarRuleSum::FillStrengths(const Matrix3X& density) const {
   const int segments = static_cast<int>(first_node_.size());
-  for (const Rule& rule : rules_) {
 #pragma omp parallel for schedule(static)
-    for (int s = 0; s < segments; ++s) {
-      const Vec3 fa = density.col(first_node_[static_cast<size_t>(s)]);
-      const Vec3 fb = density.col(first_node_[static_cast<size_t>(s)] + 1);
+  for (int s = 0; s < segments; ++s) {
+    const Vec3 fa = density.col(first_node_[static_cast<size_t>(s)]);
+    const Vec3 fb = density.col(first_node_[static_cast<size_t>(s)] + 1);
+    for (const Rule& rule : rules_)
       for (int q = 0; q < rule.points; ++q) {
         const Vec3 g = (rule.weight[q] * length_(s)) * ((1.0 - rule.alpha[q]) * fa + rule.alpha[q] * fb);
         const int row = rule.first_source + s * rule.points + q;
-        src_.row(row).tail<3>() = g.transpose();
-        if (single_) src_f_.row(row).tail<3>() = g.transpose().cast<float>();
+        if (single_)
+          src_f_.row(row).tail<3>() = g.transpose().cast<float>();
+        else
+          src_.row(row).tail<3>() = g.transpose();
       }
-    }
   }
 }
 

@@ -62,9 +62,9 @@ class FarRuleSum {
   std::vector<int> first_node_;   // per segment
   VecX length_;                   // per segment
   Matrix3X targets_;
-  Eigen::Matrix3Xf targets_f_;    // relative to origin_
-  mutable MatX src_;              // sources × 7 (x, y, z, ε², g): the strengths of the last Apply
-  mutable Eigen::MatrixXf src_f_; // the same in single precision, positions relative to origin_
+  Eigen::Matrix3Xf targets_f_;    // relative to the nodes' mean (single precision)
+  mutable MatX src_;              // sources × 7 (x, y, z, ε², g): g of the last Apply in double
+  mutable Eigen::MatrixXf src_f_; // single precision: positions relative to that mean, and g
   // Per group g of targets [g kGroupTargets, …): its source ranges range_[range_start_[g] …),
   // each one or more consecutive chunks on one rule.
   std::vector<int> range_start_;

@@ -407,6 +407,7 @@ void FmmStokesletSum::Leaves(Matrix3X* w) const {
       }
       const SourceColumns far = Columns(surface);
       const SourceColumnsF far_f = single_ ? ColumnsF(surface_f) : SourceColumnsF{};
+      const SourceRange surface_range{0, n};
       const SourceRange* near = near_ranges_.data() + near_range_start_[b];
       const int count = near_range_start_[b + 1] - near_range_start_[b];
       // The box's targets by groups of kPointSumTargets, which share its sources.
@@ -423,14 +424,13 @@ void FmmStokesletSum::Leaves(Matrix3X* w) const {
             x_local[k] = local.col(k).data();
             x_near[k] = x_f_.col(t0 + k).data();
           }
-          AddPointSumSingleTargets(far_f, 0, n, group, x_local, out);
+          AddPointSumRangesTargets(far_f, &surface_range, 1, group, x_local, out);
           AddPointSumBlocksTargets(columns_f, near, count, group, x_near, out);
         } else {
           const double* x[kPointSumTargets];
           for (int k = 0; k < group; ++k) x[k] = x_.col(t0 + k).data();
-          AddPointSumTargets(far, 0, n, group, x, out);
-          for (int r = 0; r < count; ++r)
-            AddPointSumTargets(columns, near[r].begin, near[r].end, group, x, out);
+          AddPointSumRangesTargets(far, &surface_range, 1, group, x, out);
+          AddPointSumRangesTargets(columns, near, count, group, x, out);
         }
       }
     }

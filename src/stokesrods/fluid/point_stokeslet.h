@@ -52,22 +52,19 @@ void AddPointSumBlocks(const SourceColumnsF& c, const SourceRange* ranges, int c
 /// The most targets the *Targets sums below take at once.
 inline constexpr int kPointSumTargets = 4;
 
-/// AddPointSum, AddPointSumSingle and AddPointSumBlocks at n ≤ kPointSumTargets targets x[k]
-/// (adding to w[k]) over the same sources: each block of sources is read once for all n (one
-/// target alone reads 7 vectors per 16 pairs, and its loop ran at less than half the rate of the
-/// multiply–add pipes on an Intel Xeon). Each target's sum is bit for bit the one-target sum.
-void AddPointSumTargets(const SourceColumns& c, Eigen::Index begin, Eigen::Index end, int n,
-                        const double* const* x, double* const* w);
-void AddPointSumSingleTargets(const SourceColumnsF& c, Eigen::Index begin, Eigen::Index end,
-                              int n, const float* const* x, double* const* w);
-void AddPointSumBlocksTargets(const SourceColumnsF& c, const SourceRange* ranges, int count,
-                              int n, const float* const* x, double* const* w);
-/// The same over several ranges of any length (each masked at its end on AVX-512): the lanes are
-/// reduced once per target for all ranges. Without AVX-512, range by range.
+/// The sums at n ≤ kPointSumTargets targets x[k] (adding to w[k]) over the same ranges of sources
+/// (any length: each masked at its end on AVX-512; without AVX-512 range by range): each block of
+/// sources is read once for all n (one target alone reads 7 vectors per 16 pairs, and its loop ran
+/// at less than half the rate of the multiply–add pipes on an Intel Xeon), and the lanes are
+/// reduced once per target for all ranges. Each target's sum is bit for bit the one-target sum.
 void AddPointSumRangesTargets(const SourceColumns& c, const SourceRange* ranges, int count, int n,
                               const double* const* x, double* const* w);
 void AddPointSumRangesTargets(const SourceColumnsF& c, const SourceRange* ranges, int count, int n,
                               const float* const* x, double* const* w);
+/// The same over ranges of whole blocks (AddPointSumBlocks' layout: its portable loop without
+/// AVX-512).
+void AddPointSumBlocksTargets(const SourceColumnsF& c, const SourceRange* ranges, int count,
+                              int n, const float* const* x, double* const* w);
 
 /// The compiler-vectorized loops behind AddPointSum, AddPointSumSingle and AddPointSumBlocks on
 /// CPUs without AVX-512 (there the sums run on intrinsics; the tests check both paths).

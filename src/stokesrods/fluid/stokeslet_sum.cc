@@ -205,8 +205,8 @@ void PointSumRanges512(const Columns& c, const SourceRange* ranges, int count,
       const V sx = A::Load(m, c.x + s), sy = A::Load(m, c.y + s), sz = A::Load(m, c.z + s);
       const V e2 = A::LoadOr(one, m, c.e2 + s);
       const V gx = A::Load(m, c.gx + s), gy = A::Load(m, c.gy + s), gz = A::Load(m, c.gz + s);
-    #pragma GCC unroll 8
-  for (int k = 0; k < K; ++k) {
+#pragma GCC unroll 8
+      for (int k = 0; k < K; ++k) {
         const V rx = A::Sub(px[k], sx), ry = A::Sub(py[k], sy), rz = A::Sub(pz[k], sz);
         const V inv_r = A::InverseSqrt(A::Fma(rx, rx, A::Fma(ry, ry, A::Fma(rz, rz, e2))));
         const V inv_r2 = A::Mul(inv_r, inv_r);
@@ -264,26 +264,6 @@ void PointSumTargets512(const Columns& c, const SourceRange* ranges, int count, 
 }
 
 }  // namespace
-
-void AddPointSumTargets(const SourceColumns& c, Eigen::Index begin, Eigen::Index end, int n,
-                        const double* const* x, double* const* w) {
-  if (!HasAvx512()) {
-    for (int k = 0; k < n; ++k) PointSumPortable(c, begin, end, x[k], w[k]);
-    return;
-  }
-  const SourceRange range{static_cast<int>(begin), static_cast<int>(end)};
-  PointSumTargets512(c, &range, 1, n, x, w);
-}
-
-void AddPointSumSingleTargets(const SourceColumnsF& c, Eigen::Index begin, Eigen::Index end,
-                              int n, const float* const* x, double* const* w) {
-  if (!HasAvx512()) {
-    for (int k = 0; k < n; ++k) PointSumSinglePortable(c, begin, end, x[k], w[k]);
-    return;
-  }
-  const SourceRange range{static_cast<int>(begin), static_cast<int>(end)};
-  PointSumTargets512(c, &range, 1, n, x, w);
-}
 
 void AddPointSumRangesTargets(const SourceColumns& c, const SourceRange* ranges, int count, int n,
                               const double* const* x, double* const* w) {
@@ -378,6 +358,7 @@ class DirectStokesletSum final : public StokesletSum {
     w->setZero(3, nt);
     // Groups of kPointSumTargets consecutive targets, each group summed at once.
     const Eigen::Index groups = (nt + kPointSumTargets - 1) / kPointSumTargets;
+    const SourceRange all{0, static_cast<int>(src_.rows())};
     if (single_) {
       src_f_.rightCols<3>() = strengths.transpose().cast<float>();
       const SourceColumnsF c = ColumnsF(src_f_);
@@ -386,7 +367,7 @@ class DirectStokesletSum final : public StokesletSum {
         const float* x[kPointSumTargets];
         double* out[kPointSumTargets];
         const int n = Group(g, nt, targets_f_, w, x, out);
-        AddPointSumSingleTargets(c, 0, src_f_.rows(), n, x, out);
+        AddPointSumRangesTargets(c, &all, 1, n, x, out);
       }
       return;
     }
@@ -397,7 +378,7 @@ class DirectStokesletSum final : public StokesletSum {
       const double* x[kPointSumTargets];
       double* out[kPointSumTargets];
       const int n = Group(g, nt, targets_, w, x, out);
-      AddPointSumTargets(c, 0, src_.rows(), n, x, out);
+      AddPointSumRangesTargets(c, &all, 1, n, x, out);
     }
   }
 

@@ -57,6 +57,7 @@ void ChooseBlasKernels() {
   setenv("OPENBLAS_CORETYPE", better, 0);
   gotoblas_dynamic_quit();
   gotoblas_dynamic_init();
+  unsetenv("OPENBLAS_CORETYPE");  // read by the init only: the environment stays the user's
 }
 
 const bool kBlasOnOneThread = [] {
