@@ -12,6 +12,7 @@
 #include "stokesrods/fluid/mobility_operator.h"
 #include "stokesrods/fluid/rss.h"
 #include "stokesrods/rod/geometry.h"
+#include "stokesrods/solver/blas.h"
 
 namespace stokesrods {
 namespace {
@@ -167,10 +168,51 @@ TEST(MobilityReuse, RestoredHistoryContinuesBitForBit) {
     EXPECT_EQ(resumed->reuse_stats().assemblies - restored_extra,
               run->reuse_stats().assemblies - assemblies_before) << "update " << k;
     ASSERT_EQ((*run->matrix() - *resumed->matrix()).cwiseAbs().maxCoeff(), 0.0) << "update " << k;
+    VecX u_run, u_resumed;  // and the products the Newton residuals take
+    run->Apply(VecX::Ones(run->size()), &u_run);
+    resumed->Apply(VecX::Ones(run->size()), &u_resumed);
+    ASSERT_EQ((u_run - u_resumed).cwiseAbs().maxCoeff(), 0.0) << "update " << k;
   }
   EXPECT_EQ(restored_extra, 3);  // the history's three matrices
   // The run kept extrapolating across its restart point: 83 updates, a few assemblies.
   EXPECT_LT(run->reuse_stats().assemblies - assemblies_before, 83 / 4);
+}
+
+// Where 𝕄 is assembled at every step (a turn of 0.1 rad per step), the products take it in
+// single precision from a tolerance of kSinglePrecisionTolerance on: the product of the rounded
+// matrix, summed in double (GemvRowsMixed), within 1e-6 of the double product relative to
+// |𝕄| |f|; below that tolerance they take the double 𝕄. matrix() stays the assembled one.
+TEST(MobilityReuse, ProductsTakeTheAssembledMatrixInSinglePrecisionFromItsTolerance) {
+  FluidParams params;
+  for (const double tolerance : {kSinglePrecisionTolerance, 1e-5}) {
+    MobilityOptions options;
+    options.reuse_tolerance = tolerance;
+    const auto op = MakeMobilityOperator(params, options);
+    for (int k = 0; k < 4; ++k) {
+      const std::vector<Matrix3X> x = TurnedHelices(0.1 * k);
+      op->Update(Rods(x));
+      MatX exact;
+      AssembleMobility(params, Rods(x), &exact);
+      ASSERT_EQ(op->reuse_stats().assemblies, k + 1);
+      ASSERT_EQ((*op->matrix() - exact).cwiseAbs().maxCoeff(), 0.0);
+      const VecX f = VecX::LinSpaced(exact.cols(), -1.0, 2.0);
+      VecX u, rounded(exact.rows());
+      op->Apply(f, &u);
+      const Eigen::MatrixXf single = exact.cast<float>();
+      GemvRowsMixed(single, 0, single.rows(), f.data(), rounded.data());
+      const double scale = (exact.cwiseAbs() * f.cwiseAbs()).maxCoeff();
+      const double from_double = (u - exact * f).cwiseAbs().maxCoeff() / scale;
+      if (tolerance >= kSinglePrecisionTolerance) {
+        EXPECT_EQ((u - rounded).cwiseAbs().maxCoeff(), 0.0) << "update " << k;
+        EXPECT_GT(from_double, 0.0);
+        EXPECT_LT(from_double, 1e-6);
+        ASSERT_NE(op->single_matrix(), nullptr);
+      } else {
+        EXPECT_LT(from_double, 1e-14) << "update " << k;
+        EXPECT_EQ(op->single_matrix(), nullptr);
+      }
+    }
+  }
 }
 
 // A history of another size (another model) is dropped: the operator starts over.

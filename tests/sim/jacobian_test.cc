@@ -197,13 +197,16 @@ void CheckImplicitNonlocalDrag(const std::string& fluid_options, double solve_to
   EXPECT_LT(no_slip_error, 10 * solve_tolerance);
 }
 
+// The dense 𝕄 without reuse: its products in double, as the reference's (from a reuse tolerance
+// of 1e-4 on they take 𝕄 rounded to single precision, fluid/mobility_reuse.h).
 TEST(Jacobian, ImplicitNonlocalDragTwoHelicesDirect) {
-  CheckImplicitNonlocalDrag("mobility = \"dense\"\nsolver = \"direct\"", 1e-10);
+  CheckImplicitNonlocalDrag(
+      "mobility = \"dense\"\nsolver = \"direct\"\nmobility_reuse_tolerance = 0", 1e-10);
 }
 
 TEST(Jacobian, ImplicitNonlocalDragTwoHelicesKrylov) {
-  CheckImplicitNonlocalDrag("mobility = \"dense\"\nsolver = \"krylov\"\nkrylov_tolerance = 1e-12",
-                            1e-9);
+  CheckImplicitNonlocalDrag("mobility = \"dense\"\nsolver = \"krylov\"\nkrylov_tolerance = 1e-12\n"
+                            "mobility_reuse_tolerance = 0", 1e-9);
 }
 
 // The matrix-free 𝕄 at a far-field tolerance of 1e-10 against the dense reference.

@@ -29,7 +29,9 @@ namespace {
 class DenseMobility final : public MobilityOperator {
  public:
   DenseMobility(const FluidParams& params, const MobilityOptions& options)
-      : params_(params), reuse_(options.reuse_tolerance) {}
+      : params_(params),
+        reuse_(options.reuse_tolerance),
+        single_products_(options.reuse_tolerance >= kSinglePrecisionTolerance) {}
 
   void Update(const std::vector<HydroRod>& rods) override {
     SetLayout(rods);
@@ -50,12 +52,19 @@ class DenseMobility final : public MobilityOperator {
     };
     single_current_ = !reuse_.Update(x, assemble, &matrix_, &single_);
     double_stale_ = single_current_;
+    // At a reuse tolerance of single precision's order or above, the products take an assembled
+    // 𝕄 rounded to single precision too (the history holds it already): 6e-8 relative to its
+    // entries, far inside what the extrapolated steps are allowed, at half the bytes per product.
+    products_ = single_current_ ? &single_
+                : single_products_ ? &reuse_.last_assembly_single()
+                                   : nullptr;
   }
   void UpdateWithBodies(const std::vector<HydroRod>& rods,
                         const std::vector<BodySurface>& bodies) override {
     if (bodies.empty()) return Update(rods);  // every fluid model
     reuse_.Forget();  // bodies: assembled at every Update
     single_current_ = double_stale_ = false;
+    products_ = nullptr;
     SetLayout(rods);
     for (const BodySurface& b : bodies) {
       num_body_points_ += static_cast<int>(b.points.cols());
@@ -70,14 +79,14 @@ class DenseMobility final : public MobilityOperator {
   MobilityReuseStats reuse_stats() const override { return reuse_.stats(); }
   void Apply(const VecX& force, VecX* velocity) const override {
     // Row blocks in parallel: the product streams the whole matrix (memory bound beyond cache).
-    const Eigen::Index n = single_current_ ? single_.rows() : matrix_.rows();
+    const Eigen::Index n = products_ ? products_->rows() : matrix_.rows();
     velocity->resize(n);
     constexpr Eigen::Index kRows = 192;
 #pragma omp parallel for schedule(static) if (n > 2 * kRows)
     for (Eigen::Index first = 0; first < n; first += kRows) {
       const Eigen::Index rows = std::min(kRows, n - first);
-      if (single_current_)
-        GemvRowsMixed(single_, first, rows, force.data(), velocity->data() + first);
+      if (products_)
+        GemvRowsMixed(*products_, first, rows, force.data(), velocity->data() + first);
       else
         GemvRows(matrix_, first, rows, force.data(), velocity->data() + first);
     }
@@ -93,9 +102,7 @@ class DenseMobility final : public MobilityOperator {
     if (double_stale_) matrix_ = single_.cast<double>(), double_stale_ = false;
     return &matrix_;
   }
-  const Eigen::MatrixXf* single_matrix() const override {
-    return single_current_ ? &single_ : nullptr;
-  }
+  const Eigen::MatrixXf* single_matrix() const override { return products_; }
 
  private:
   FluidParams params_;
@@ -104,6 +111,8 @@ class DenseMobility final : public MobilityOperator {
   Eigen::MatrixXf single_;       // extrapolated by the reuse (fluid/mobility_reuse.h)
   bool single_current_ = false;  // the last Update extrapolated: single_ is 𝕄
   mutable bool double_stale_ = false;  // matrix_ is not single_ yet
+  bool single_products_ = false;  // reuse tolerance ≥ kSinglePrecisionTolerance
+  const Eigen::MatrixXf* products_ = nullptr;  // 𝕄 the products take in single precision, if so
 };
 
 // out (compressed rows) from the blocks per target, packed in parallel.

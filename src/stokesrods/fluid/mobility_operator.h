@@ -85,7 +85,9 @@ struct MobilityOptions {
   /// rod (tests, the reference) [–].
   bool far_rule_by_distance = true;
   /// Dense: 𝕄 reused across Updates (time steps) by extrapolation while its measured relative
-  /// error stays below this (fluid/mobility_reuse.h); 0 assembles at every Update [–].
+  /// error stays below this (fluid/mobility_reuse.h); 0 assembles at every Update. From
+  /// kSinglePrecisionTolerance on, the products take 𝕄 in single precision also where it was
+  /// assembled (sums in double, solver/blas.h GemvRowsMixed) [–].
   double reuse_tolerance = 0.0;
 };
 
@@ -108,8 +110,9 @@ class MobilityOperator {
   virtual MatX SelfBlock(int rod) const = 0;
   /// The assembled 𝕄 when the operator holds one, else nullptr.
   virtual const MatX* matrix() const { return nullptr; }
-  /// 𝕄 in single precision when the last Update made it so (the dense 𝕄 extrapolated by its
-  /// reuse, fluid/mobility_reuse.h), else nullptr: for what reads it in single precision anyway.
+  /// 𝕄 in single precision when the products take it so (the dense 𝕄 extrapolated by its reuse,
+  /// fluid/mobility_reuse.h, or assembled and rounded at a reuse tolerance ≥
+  /// kSinglePrecisionTolerance), else nullptr: for what reads it in single precision anyway.
   virtual const Eigen::MatrixXf* single_matrix() const { return nullptr; }
   /// Forgets what the operator keeps from earlier Updates: the next Update then depends on its
   /// geometry alone.

@@ -37,7 +37,9 @@
 // rounding (6e-8 relative, a few times that through s and s(s + 1)) is part of the e measured,
 // and at a tolerance near it 𝕄 is simply assembled at every step (tested at 1e-8; reused at 1e-5). The extrapolated matrix
 // streams half the bytes of a double one in the products, which sum in double (solver/blas.h
-// GemvRowsMixed).
+// GemvRowsMixed). From a tolerance of kSinglePrecisionTolerance (1e-4) on, the dense operator's
+// products take the assembled 𝕄 rounded too (last_assembly_single(), the history's 𝕄_c): at a
+// large step, where 𝕄 is assembled at every step, each product then streams half the bytes.
 #pragma once
 
 #include <functional>
@@ -87,6 +89,9 @@ class MobilityReuse {
   /// goes on as the reuse it was taken from would (a history of another size is dropped there).
   void Restore(const MobilityReuseHistory& history);
   const MobilityReuseStats& stats() const { return stats_; }
+  /// 𝕄 of the last assembly rounded to single precision (the history's 𝕄_c); empty with
+  /// tolerance 0 and before the first assembly.
+  const Eigen::MatrixXf& last_assembly_single() const { return base_; }
 
  private:
   /// s(x) on the line through the last two geometries.
