@@ -38,20 +38,26 @@ std::vector<HydroRod> Rods(const std::vector<Matrix3X>& x) {
 struct Outcome {
   double worst_error = 0.0;  ///< max over steps of ‖𝕄_used − 𝕄_exact‖_F / ‖𝕄_exact‖_F
   MobilityReuseStats stats;
+  MobilityReuseStats fast;  ///< after the fast turns
   bool exact_where_assembled = true;
 };
 
-// `steps` updates turning by `step_angle` each, the operator's 𝕄 against the exact one.
-Outcome Turn(double tolerance, double step_angle, int steps, int forget_every = 0) {
+// `steps` updates turning by `step_angle` each (after `fast_steps` of `fast_angle` each, if
+// any), the operator's 𝕄 against the exact one.
+Outcome Turn(double tolerance, double step_angle, int steps, int forget_every = 0,
+             int fast_steps = 0, double fast_angle = 0.0) {
   FluidParams params;
   MobilityOptions options;
   options.reuse_tolerance = tolerance;
   const auto op = MakeMobilityOperator(params, options);
   Outcome out;
   long assemblies = 0;
-  for (int k = 0; k < steps; ++k) {
+  for (int k = 0; k < fast_steps + steps; ++k) {
     if (forget_every > 0 && k % forget_every == 0) op->ForgetHistory();
-    const std::vector<Matrix3X> x = TurnedHelices(k * step_angle);
+    const double angle = k < fast_steps ? k * fast_angle
+                                        : fast_steps * fast_angle + (k - fast_steps) * step_angle;
+    const std::vector<Matrix3X> x = TurnedHelices(angle);
+    if (k == fast_steps) out.fast = op->reuse_stats();
     op->Update(Rods(x));
     MatX exact;
     AssembleMobility(params, Rods(x), &exact);
@@ -104,6 +110,28 @@ TEST(MobilityReuse, LargeStepsAssembleEveryTime) {
   EXPECT_EQ(sixty.stats.assemblies, 30);
   EXPECT_EQ(sixty.worst_error, 0.0);
   EXPECT_EQ(sixty.stats.largest_error, 0.0);
+}
+
+// Where even the quadratic extrapolation misses for two steps, measurements are skipped (1, 2,
+// 4, 8 assemblies in a row, then three that rebuild and measure the history): over 60 large turns
+// a third or fewer of the assemblies measure. When the motion slows to Fig. 1's at h = 1 ms, the
+// reuse starts again within kMaxSkip + 2 assemblies of its start without skipping: 150 updates
+// then assemble fewer than 150/4 + kMaxSkip + 2 times, within the tolerance.
+TEST(MobilityReuse, LargeStepsSkipMeasurementsAndSlowerOnesReuseAgain) {
+  const Outcome large = Turn(1e-4, 0.1, 60);
+  std::printf("  turn 0.1 rad per step: %ld of 60 assemblies measured\n", large.stats.measurements);
+  EXPECT_EQ(large.stats.assemblies, 60);
+  EXPECT_EQ(large.worst_error, 0.0);
+  EXPECT_GT(large.stats.measurements, 0);
+  EXPECT_LE(large.stats.measurements, 60 / 3);
+  const Outcome slower = Turn(1e-4, 1.6e-3, 150, 0, 40, 0.1);
+  const long slow_assemblies = slower.stats.assemblies - slower.fast.assemblies;
+  std::printf("  then 1.6e-3 rad per step: %ld of 150 updates assembled, worst error %.2e\n",
+              slow_assemblies, slower.worst_error);
+  EXPECT_EQ(slower.fast.assemblies, 40);
+  EXPECT_LT(slow_assemblies, 150 / 4 + MobilityReuse::kMaxSkip + 2);
+  EXPECT_LT(slower.worst_error, 1.5e-4);
+  EXPECT_TRUE(slower.exact_where_assembled);
 }
 
 // The history is kept in single precision (6e-8 relative): a tolerance below what that rounding
@@ -213,6 +241,42 @@ TEST(MobilityReuse, ProductsTakeTheAssembledMatrixInSinglePrecisionFromItsTolera
       }
     }
   }
+}
+
+// The same while measurements are skipped (large turns, then slow ones): a history taken in the
+// middle of a run of skipped measurements continues as the uninterrupted operator, bit for bit,
+// measuring and assembling where it does.
+TEST(MobilityReuse, RestoredHistoryContinuesBitForBitWhileSkipping) {
+  FluidParams params;
+  MobilityOptions options;
+  options.reuse_tolerance = 1e-4;
+  const auto angle = [](int k) { return k < 40 ? 0.1 * k : 4.0 + 1.6e-3 * (k - 40); };
+  const auto run = MakeMobilityOperator(params, options);
+  int first = 0;  // the restart: past the first skipped measurement, one skipped next
+  while (first < 40 && (first < 8 || run->reuse_history().skip == 0))
+    run->Update(Rods(TurnedHelices(angle(first++))));
+  run->AtRestartPoint();
+  const MobilityReuseHistory kept = run->reuse_history();
+  ASSERT_GT(kept.skip, 0);  // in the middle of skipped measurements
+  const MobilityReuseStats before = run->reuse_stats();
+  const auto resumed = MakeMobilityOperator(params, options);
+  resumed->RestoreReuse(kept);
+  const VecX f = VecX::Ones(run->size());
+  for (int k = first; k < 140; ++k) {
+    const std::vector<Matrix3X> x = TurnedHelices(angle(k));
+    run->Update(Rods(x));
+    resumed->Update(Rods(x));
+    const long extra = static_cast<long>(kept.geometries.size());  // assembled again on restore
+    ASSERT_EQ(resumed->reuse_stats().assemblies - extra,
+              run->reuse_stats().assemblies - before.assemblies) << "update " << k;
+    ASSERT_EQ(resumed->reuse_stats().measurements,
+              run->reuse_stats().measurements - before.measurements) << "update " << k;
+    VecX u_run, u_resumed;
+    run->Apply(f, &u_run);
+    resumed->Apply(f, &u_resumed);
+    ASSERT_EQ((u_run - u_resumed).cwiseAbs().maxCoeff(), 0.0) << "update " << k;
+  }
+  EXPECT_LT(run->reuse_stats().assemblies - before.assemblies, 140 - first - 50);  // reused again
 }
 
 // A history of another size (another model) is dropped: the operator starts over.

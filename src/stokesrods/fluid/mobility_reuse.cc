@@ -98,6 +98,8 @@ bool MobilityReuse::Update(const VecX& x, const Assemble& assemble, MatX* assemb
       }
       since_ = kept.since;
       interval_ = kept.interval;
+      skip_ = kept.skip;
+      skip_length_ = kept.skip_length;
     }
   }
   const bool same_size = !geometries_.empty() && geometries_.back().size() == x.size();
@@ -113,8 +115,25 @@ bool MobilityReuse::Update(const VecX& x, const Assemble& assemble, MatX* assemb
   if (!same_size) Forget();
   assemble(x, assembled);
   ++stats_.assemblies;
-  Take(x, *assembled, geometries_.size() >= 2);
+  if (skip_ > 0) {
+    --skip_;
+    TakeBaseOnly(x, *assembled);
+  } else {
+    Take(x, *assembled, geometries_.size() >= 2);
+  }
   return true;
+}
+
+void MobilityReuse::TakeBaseOnly(const VecX& x, const MatX& assembled) {
+  base_.resize(assembled.rows(), assembled.cols());
+  const double* exact = assembled.data();
+  float* base = base_.data();
+#pragma omp simd
+  for (Eigen::Index i = 0; i < assembled.size(); ++i) base[i] = static_cast<float>(exact[i]);
+  geometries_.assign(1, x);
+  quadratic_ = false;
+  since_ = 0;
+  interval_ = 1;
 }
 
 void MobilityReuse::Take(const VecX& x, const MatX& assembled, bool measure) {
@@ -152,6 +171,7 @@ void MobilityReuse::Take(const VecX& x, const MatX& assembled, bool measure) {
   const double miss = std::sqrt(TakeAssembly(assembled.size(), assembled.data(), pass,
                                              base_.data(), slope_.data(), curve_.data(), &norm2));
   if (measure) {
+    ++stats_.measurements;
     const double error = miss / std::max(std::sqrt(norm2), 1e-300);
     if (since_ > 0) stats_.largest_error = std::max(stats_.largest_error, error);
     const int used = since_ + 1;
@@ -159,6 +179,13 @@ void MobilityReuse::Take(const VecX& x, const MatX& assembled, bool measure) {
     const double grow = error > 0.0 ? 0.9 * std::pow(tolerance_ / error, 1.0 / order) : 2.0;
     interval_ = std::clamp(static_cast<int>(std::floor(used * std::min(grow, 2.0))), 1,
                            kMaxInterval);
+    // The quadratic one missed for two steps: skip the next measurements (header, SKIPPING).
+    if (quadratic_ && interval_ == 1) {
+      skip_length_ = std::min(std::max(2 * skip_length_, 1), kMaxSkip);
+      skip_ = skip_length_;
+    } else if (interval_ > 1) {
+      skip_length_ = 0;
+    }
   }
   quadratic_ = quadratic;
   if (held == static_cast<std::size_t>(kMaxHeld)) geometries_.erase(geometries_.begin());
@@ -171,6 +198,7 @@ void MobilityReuse::Forget() {
   quadratic_ = false;
   since_ = 0;
   interval_ = 1;
+  skip_ = skip_length_ = 0;
   restore_.reset();
 }
 
@@ -180,6 +208,8 @@ MobilityReuseHistory MobilityReuse::history() const {
   if (tolerance_ <= 0.0) return kept;
   kept.since = since_;
   kept.interval = interval_;
+  kept.skip = skip_;
+  kept.skip_length = skip_length_;
   kept.geometries = geometries_;
   return kept;
 }

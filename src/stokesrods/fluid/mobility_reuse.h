@@ -23,6 +23,13 @@
 // difference would amplify the history's rounding). Forget drops the history. The largest e
 // measured is kept in the statistics (an interval is shortened after the fact, not redone).
 //
+// SKIPPING. Measuring and keeping D₁, D₂ is a pass over four matrices at each assembly. Where
+// even the quadratic extrapolation misses for two steps (m stays 1: large steps), the next
+// assemblies take 𝕄_c only, 1, 2, 4, then kMaxSkip of them in a row while that repeats; then the
+// history is rebuilt over the next three (D₁, D₂ and the measurement) as after Forget. 𝕄 is assembled at every
+// step either way, so the results are the same; reuse can start at most kMaxSkip + 2 assemblies
+// later than with a measurement at every one.
+//
 // Measured on paper Fig. 1 at h = 1 ms (t = 0.3 s, assembling at every step for the check): 20
 // steps from a history 8 steps apart miss by 9.5e-5 linearly and 4.0e-6 quadratically; 40 steps
 // by 3.3e-4 and 2.1e-5 (docs/performance.md).
@@ -54,12 +61,15 @@ struct MobilityReuseStats {
   long updates = 0;             ///< geometries 𝕄 was taken at
   long assemblies = 0;          ///< of which assembled
   double largest_error = 0.0;   ///< largest e measured (relative Frobenius)
+  long measurements = 0;        ///< assemblies at which e was measured
 };
 
 /// The reuse's history short of its matrices: what a checkpoint keeps (io/checkpoint.h).
 struct MobilityReuseHistory {
   int since = 0;       ///< updates since the last assembly
   int interval = 1;    ///< updates from one assembly to the next
+  int skip = 0;        ///< assemblies left that take 𝕄_c only (MobilityReuse::kMaxSkip)
+  int skip_length = 0; ///< the length of the last such run
   /// The geometries (3M each) of the assemblies held since the last Forget, oldest first: at
   /// most kMaxHeld.
   std::vector<VecX> geometries;
@@ -73,6 +83,9 @@ class MobilityReuse {
   static constexpr int kMaxInterval = 40;
   /// The most assemblies the extrapolation goes through.
   static constexpr int kMaxHeld = 3;
+  /// The most assemblies in a row that take 𝕄_c only, after the quadratic extrapolation missed
+  /// for even two steps.
+  static constexpr int kMaxSkip = 8;
 
   explicit MobilityReuse(double tolerance) : tolerance_(tolerance) {}
 
@@ -98,10 +111,14 @@ class MobilityReuse {
   double Position(const VecX& x) const;
   /// Takes the assembled 𝕄(x) into the history; measures the extrapolation's miss when `measure`.
   void Take(const VecX& x, const MatX& assembled, bool measure);
+  /// Takes the assembled 𝕄(x) as 𝕄_c alone: the history starts again from it.
+  void TakeBaseOnly(const VecX& x, const MatX& assembled);
 
   double tolerance_ = 0.0;
   int since_ = 0;      ///< updates since the last assembly
   int interval_ = 1;   ///< updates from one assembly to the next
+  int skip_ = 0;         ///< assemblies left that take 𝕄_c only
+  int skip_length_ = 0;  ///< the last run of them: doubles while the extrapolation keeps missing
   std::vector<VecX> geometries_;  ///< of the assemblies held, oldest first (≤ kMaxHeld)
   bool quadratic_ = false;        ///< curve_ holds D₂
   Eigen::MatrixXf base_;   ///< 𝕄_c

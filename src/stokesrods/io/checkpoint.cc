@@ -12,8 +12,9 @@ namespace stokesrods {
 namespace {
 
 constexpr char kMagic[8] = {'S', 'R', 'C', 'K', 'P', 'T', '\0', '\0'};
-// 4: the earlier drags; 5: the bodies' previous poses; 6: the dense 𝕄's reuse history
-constexpr std::uint32_t kVersion = 6;
+// 4: the earlier drags; 5: the bodies' previous poses; 6: the dense 𝕄's reuse history; 7: its
+// skipped measurements
+constexpr std::uint32_t kVersion = 7;
 constexpr std::uint32_t kOldestVersion = 2;  // without the controls
 
 std::uint64_t Fnv1a(const char* data, std::size_t bytes, std::uint64_t hash = 14695981039346656037ull) {
@@ -166,6 +167,8 @@ void SaveCheckpoint(const std::string& path, const Model& model, const Checkpoin
   w.Put(static_cast<std::int64_t>(reuse.since));
   w.Put(static_cast<std::int64_t>(reuse.interval));
   for (const VecX& g : reuse.geometries) w.Vector(g);
+  w.Put(static_cast<std::int64_t>(reuse.skip));  // version 7
+  w.Put(static_cast<std::int64_t>(reuse.skip_length));
   w.Put(Fnv1a(w.text().data(), w.text().size()));
   WriteFileAtomically(path, w.text());
 }
@@ -246,6 +249,14 @@ Checkpoint LoadCheckpoint(const std::string& path, const Model& model) {
     reuse.interval = static_cast<int>(interval);
     for (std::int64_t k = 0; k < held; ++k)
       reuse.geometries.push_back(r.Vector(3 * model.num_nodes, "a geometry of the reuse"));
+  }
+  if (version >= 7) {  // the reuse's measurements skipped
+    MobilityReuseHistory& reuse = c.history.mobility_reuse;
+    const auto skip = r.Get<std::int64_t>(), length = r.Get<std::int64_t>();
+    if (skip < 0 || length < skip || length > MobilityReuse::kMaxSkip)
+      r.Fail(fmt::format("the reuse's {} of {} skipped measurements is not possible", skip, length));
+    reuse.skip = static_cast<int>(skip);
+    reuse.skip_length = static_cast<int>(length);
   }
   if (r.at() + sizeof stored_sum != text.size()) r.Fail("unexpected data after the contents");
   return c;

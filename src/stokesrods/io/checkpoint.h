@@ -17,9 +17,11 @@
 // the result within the Newton tolerance only. Version 5 adds the bodies' poses at t_{k−1} (BDF2
 // with free bodies); resumed from an older file, BDF2 with free bodies takes one implicit Euler
 // step first. Version 6 adds the dense 𝕄's reuse history; resumed from an older file, the reuse
-// starts over (a few more assemblies; the result changes within the reuse's tolerance).
+// starts over (a few more assemblies; the result changes within the reuse's tolerance). Version 7
+// adds the reuse's skipped measurements (fluid/mobility_reuse.h, SKIPPING); from version 6 the
+// reuse measures at the next assembly (the same 𝕄 at every step while it assembles at each).
 //
-// Format (little-endian, version 6): "SRCKPT\0\0", uint32 version, the payload, then the FNV-1a
+// Format (little-endian, version 7): "SRCKPT\0\0", uint32 version, the payload, then the FNV-1a
 // 64-bit hash of everything before it. Written atomically (temporary file, then rename); a
 // damaged, truncated, foreign or other-version file is refused with an IoError naming it.
 #pragma once

@@ -84,7 +84,8 @@ class Observer {
     if (IsNonlocal(model_.fluid.model))
       s["mobility_reuse"] = {{"updates", result.mobility_reuse.updates},
                              {"assemblies", result.mobility_reuse.assemblies},
-                             {"largest_error", result.mobility_reuse.largest_error}};
+                             {"largest_error", result.mobility_reuse.largest_error},
+                             {"measurements", result.mobility_reuse.measurements}};
     s["krylov_products"] = result.krylov_products;
     s["version"] = STOKESRODS_VERSION;
     WriteFileAtomically((fs::path(plan_.output_dir) / "summary.json").string(), s.dump(2) + "\n");
