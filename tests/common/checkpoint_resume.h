@@ -10,6 +10,7 @@
 #include <string>
 
 #include "stokesrods/io/simulation.h"
+#include "common/scratch_dir.h"
 
 namespace stokesrods {
 
@@ -20,8 +21,7 @@ struct ResumedPair {
 /// Runs the configuration `text` for `before` steps, saves a checkpoint, loads it into a fresh
 /// Simulation, then steps both `after` more steps (a failed step is a test failure).
 inline ResumedPair RunAndResume(const std::string& text, int before, int after) {
-  const std::string path = (std::filesystem::temp_directory_path() /
-                            ("stokesrods_resume." + std::to_string(getpid()))).string();
+  const std::string path = testing::ScratchPath("stokesrods_resume").string();
   ResumedPair p{std::make_unique<Simulation>(ParseConfig(text, "case.toml")), nullptr};
   for (int k = 0; k < before; ++k) EXPECT_TRUE(p.uninterrupted->Step().ok);
   p.uninterrupted->SaveCheckpoint(path);

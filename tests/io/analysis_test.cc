@@ -9,6 +9,7 @@
 
 #include "stokesrods/io/analysis.h"
 #include "stokesrods/io/sweep.h"
+#include "common/scratch_dir.h"
 
 namespace stokesrods {
 namespace {
@@ -16,7 +17,7 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path RunDir(const std::string& name, const std::string& csv) {
-  const fs::path dir = fs::temp_directory_path() / ("stokesrods_analysis_test." + std::to_string(getpid())) / name;
+  const fs::path dir = testing::ScratchPath("stokesrods_analysis_test") / name;
   fs::create_directories(dir);
   std::ofstream(dir / "timeseries.csv") << csv;
   std::ofstream(dir / "summary.json")

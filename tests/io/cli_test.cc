@@ -12,6 +12,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/scratch_dir.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -40,7 +42,7 @@ Outcome RunCli(const std::string& args) {
 }
 
 fs::path WriteConfig(const std::string& name, const std::string& text) {
-  const fs::path dir = fs::temp_directory_path() / ("stokesrods_cli_test." + std::to_string(getpid()));
+  const fs::path dir = stokesrods::testing::ScratchPath("stokesrods_cli_test");
   fs::create_directories(dir);
   std::ofstream(dir / name) << text;
   return dir / name;
@@ -61,7 +63,7 @@ TEST(Cli, VersionAndHelp) {
 }
 
 TEST(Cli, ShowConfigPrintsEveryDefaultAndTheDerivedQuantities) {
-  const fs::path out = fs::temp_directory_path() / ("stokesrods_cli_show." + std::to_string(getpid()));
+  const fs::path out = stokesrods::testing::ScratchPath("stokesrods_cli_show");
   const std::string cmd = std::string(STOKESRODS_BINARY) + " show-config " + STOKESRODS_SOURCE_DIR +
                           "/examples/helix.toml --set rods.omega_bar=1067 > " + out.string();
   ASSERT_EQ(WEXITSTATUS(std::system(cmd.c_str())), 0);
@@ -73,7 +75,7 @@ TEST(Cli, ShowConfigPrintsEveryDefaultAndTheDerivedQuantities) {
 }
 
 TEST(Cli, CantileverWritesTheSpecFiles) {
-  const fs::path out = fs::temp_directory_path() / ("stokesrods_cli_cantilever." + std::to_string(getpid()));
+  const fs::path out = stokesrods::testing::ScratchPath("stokesrods_cli_cantilever");
   fs::remove_all(out);
   const Outcome o = RunCli(std::string("run ") + STOKESRODS_SOURCE_DIR + "/examples/cantilever.toml --output " + out.string());
   ASSERT_EQ(o.code, 0) << o.err;
@@ -116,7 +118,7 @@ TEST(Cli, UnwritableOutputIsExitFour) {
 }
 
 TEST(Cli, NumericalFailureIsExitThreeWithTheLastGoodStateSaved) {
-  const fs::path out = fs::temp_directory_path() / ("stokesrods_cli_failure." + std::to_string(getpid()));
+  const fs::path out = stokesrods::testing::ScratchPath("stokesrods_cli_failure");
   fs::remove_all(out);
   // One Newton iteration cannot converge a step that starts far from equilibrium.
   const fs::path cfg = WriteConfig(
@@ -138,7 +140,7 @@ TEST(Cli, AFailedStepSaysWhenWhereAndWhatAndIsHalvedWhenAllowed) {
       "halve.toml", "[run]\nduration = 1.0\ntime_step = 0.25\n[fluid]\nmodel = \"none\"\n"
                     "[solver]\nnewton_max_iterations = 10\ndamping = 1.0\n[[rods]]\n"
                     "shape = \"straight\"\nnodes = 21\nloads = [{node = 20, force = [1e-3, 0.0, 0.0]}]\n");
-  const fs::path out = fs::temp_directory_path() / ("stokesrods_cli_halve." + std::to_string(getpid()));
+  const fs::path out = stokesrods::testing::ScratchPath("stokesrods_cli_halve");
   fs::remove_all(out);
   const Outcome failed = RunCli("run " + cfg.string() + " --output " + out.string());
   EXPECT_EQ(failed.code, 3);
@@ -171,7 +173,7 @@ TEST(Cli, AContactFailureSaysWhenWhereAndWhatAndSavesTheLastGoodState) {
                       "[[rods]]\nshape = \"straight\"\nnodes = 21\n"
                       "loads = [{node = 20, force = [1e-3, 0.0, 0.0]}]\n"
                       "[[rods]]\nshape = \"straight\"\nnodes = 21\nbase = [0.003, 0.0, 0.0]\n");
-  const fs::path out = fs::temp_directory_path() / ("stokesrods_cli_contact." + std::to_string(getpid()));
+  const fs::path out = stokesrods::testing::ScratchPath("stokesrods_cli_contact");
   fs::remove_all(out);
   const Outcome o = RunCli("run " + cfg.string() + " --output " + out.string());
   EXPECT_EQ(o.code, 3) << o.err;
@@ -196,7 +198,7 @@ TEST(Cli, AContactFailureSaysWhenWhereAndWhatAndSavesTheLastGoodState) {
 }
 
 TEST(Cli, InterruptFlushesWritesACheckpointAndExits130) {
-  const fs::path out = fs::temp_directory_path() / ("stokesrods_cli_interrupt." + std::to_string(getpid()));
+  const fs::path out = stokesrods::testing::ScratchPath("stokesrods_cli_interrupt");
   fs::remove_all(out);
   const fs::path cfg = WriteConfig("long.toml", "[run]\nduration = 1000.0\ntime_step = 0.01\n"
                                                 "[fluid]\nmodel = \"rss\"\n[[rods]]\nnodes = 21\n"
@@ -219,8 +221,8 @@ TEST(Cli, ResumeContinuesFromTheCheckpointAsIfNeverStopped) {
                            "checkpoint_interval = 0.1\nintegrator = \"bdf2\"\n[fluid]\nmodel = \"rss\"\n"
                            "[solver]\njacobian_max_age = 5\n[[rods]]\nnodes = 21\nomega_bar = 800\n";
   const fs::path cfg = WriteConfig("resume.toml", base);
-  const fs::path whole = fs::temp_directory_path() / ("stokesrods_cli_whole." + std::to_string(getpid()));
-  const fs::path parts = fs::temp_directory_path() / ("stokesrods_cli_parts." + std::to_string(getpid()));
+  const fs::path whole = stokesrods::testing::ScratchPath("stokesrods_cli_whole");
+  const fs::path parts = stokesrods::testing::ScratchPath("stokesrods_cli_parts");
   fs::remove_all(whole);
   fs::remove_all(parts);
   ASSERT_EQ(RunCli("run " + cfg.string() + " --set run.duration=0.6 --output " + whole.string()).code, 0);
@@ -247,7 +249,7 @@ TEST(Cli, ResumeContinuesFromTheCheckpointAsIfNeverStopped) {
 TEST(Cli, ResumeRefusesADamagedForeignOrMismatchedCheckpoint) {
   const fs::path cfg = WriteConfig("ck.toml", "[run]\nduration = 0.05\ntime_step = 0.01\n"
                                               "[fluid]\nmodel = \"rft\"\n[[rods]]\nnodes = 11\n");
-  const fs::path out = fs::temp_directory_path() / ("stokesrods_cli_checkpoint." + std::to_string(getpid()));
+  const fs::path out = stokesrods::testing::ScratchPath("stokesrods_cli_checkpoint");
   fs::remove_all(out);
   const std::string run = "run " + cfg.string() + " --output " + out.string();
   ASSERT_EQ(RunCli(run).code, 0);

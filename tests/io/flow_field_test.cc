@@ -16,6 +16,7 @@
 #include "common/small_helices.h"
 #include "stokesrods/io/flow_field.h"
 #include "stokesrods/sim/integrator.h"
+#include "common/scratch_dir.h"
 
 namespace stokesrods {
 namespace {
@@ -53,11 +54,11 @@ std::vector<double> FlowWith(const std::string& mobility, const std::string& dir
 // The matrix-free operator's far field at 1e-8 against the dense 𝕄 within 1e-6 of the largest
 // speed, and at its default accuracy (1e-4) within 1e-4.
 TEST(FlowField, MatrixFreeMatchesDense) {
-  const std::string base = (std::filesystem::temp_directory_path() / ("stokesrods_flow_test." + std::to_string(getpid()))).string();
-  const std::vector<double> dense = FlowWith("dense", base + "_dense");
+  const std::string base = testing::ScratchPath("stokesrods_flow_test").string();
+  const std::vector<double> dense = FlowWith("dense", base + "/dense");
   for (const auto& [extra, bound] :
        {std::pair<std::string, double>{"fast_sum_tolerance = 1e-8", 1e-6}, {"", 1e-4}}) {
-    const std::vector<double> free = FlowWith("matrix_free", base + "_free", extra);
+    const std::vector<double> free = FlowWith("matrix_free", base + "/free", extra);
     ASSERT_EQ(dense.size(), free.size());
     ASSERT_EQ(dense.size(), 3u * 7u * 9u);
     double largest = 0.0, difference = 0.0;

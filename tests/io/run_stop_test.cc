@@ -10,6 +10,7 @@
 #include "stokesrods/io/analysis.h"
 #include "stokesrods/io/config.h"
 #include "stokesrods/io/runner.h"
+#include "common/scratch_dir.h"
 
 namespace stokesrods {
 namespace {
@@ -20,8 +21,7 @@ namespace fs = std::filesystem;
 // Steps that fail are halved: after the buckling the full run needs it, and a step that succeeds
 // is the same step with or without the option.
 RunResult RunHelix(const std::string& name, double omega_bar, bool stop, double t_bar_end) {
-  const fs::path dir = fs::temp_directory_path() /
-                       ("stokesrods_run_stop_test." + std::to_string(getpid())) / name;
+  const fs::path dir = testing::ScratchPath("stokesrods_run_stop_test") / name;
   fs::remove_all(dir);
   const Config config = LoadConfig(
       std::string(STOKESRODS_SOURCE_DIR) + "/examples/helix.toml",

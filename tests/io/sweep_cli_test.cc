@@ -15,6 +15,8 @@
 #include <map>
 #include <sstream>
 
+#include "common/scratch_dir.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -25,7 +27,7 @@ const char* kBase =
     "[[rods]]\nnodes = 11\nomega_bar = 100\n";
 
 fs::path Dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("stokesrods_sweep_cli." + std::to_string(getpid()) + "." + name);
+  const fs::path dir = stokesrods::testing::ScratchPath("stokesrods_sweep_cli") / name;
   fs::remove_all(dir);
   fs::create_directories(dir);
   std::ofstream(dir / "base.toml") << kBase;

@@ -11,6 +11,8 @@
 #include "stokesrods/io/config.h"
 #include "stokesrods/io/sweep.h"
 
+#include "common/scratch_dir.h"
+
 namespace stokesrods {
 namespace {
 
@@ -22,7 +24,7 @@ const char* kBase =
     "omega_bar = 100\n";
 
 fs::path Dir() {
-  const fs::path dir = fs::temp_directory_path() / ("stokesrods_sweep_test." + std::to_string(getpid()));
+  const fs::path dir = testing::ScratchPath("stokesrods_sweep_test");
   fs::create_directories(dir);
   std::ofstream(dir / "base.toml") << kBase;
   return dir;

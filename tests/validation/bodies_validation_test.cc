@@ -20,6 +20,7 @@
 #include "stokesrods/rod/frames.h"
 #include "stokesrods/sim/bodies.h"
 #include "stokesrods/sim/observables.h"
+#include "common/scratch_dir.h"
 
 namespace stokesrods {
 namespace {
@@ -219,8 +220,7 @@ TEST(BodiesValidation, ACheckpointResumesBitIdentically) {
 
 // The run writes the bodies' frames beside the rods' (bodies.pvd, frames/bodies_NNNNN.vtp).
 TEST(BodiesValidation, TheRunWritesBodyFrames) {
-  const std::string dir = (std::filesystem::temp_directory_path() /
-                           ("stokesrods_bodies_frames." + std::to_string(getpid()))).string();
+  const std::string dir = testing::ScratchPath("stokesrods_bodies_frames").string();
   Config config = ParseConfig(kPass, "pass.toml");
   config.run.output = dir;
   const RunResult result = RunCase(config);
