@@ -115,25 +115,12 @@ bool MobilityReuse::Update(const VecX& x, const Assemble& assemble, MatX* assemb
   if (!same_size) Forget();
   assemble(x, assembled);
   ++stats_.assemblies;
-  if (skip_ > 0) {
+  if (skip_ > 0) {  // 𝕄_c only: the history starts again from this assembly (SKIPPING)
     --skip_;
-    TakeBaseOnly(x, *assembled);
-  } else {
-    Take(x, *assembled, geometries_.size() >= 2);
+    geometries_.clear();
   }
+  Take(x, *assembled, geometries_.size() >= 2);
   return true;
-}
-
-void MobilityReuse::TakeBaseOnly(const VecX& x, const MatX& assembled) {
-  base_.resize(assembled.rows(), assembled.cols());
-  const double* exact = assembled.data();
-  float* base = base_.data();
-#pragma omp simd
-  for (Eigen::Index i = 0; i < assembled.size(); ++i) base[i] = static_cast<float>(exact[i]);
-  geometries_.assign(1, x);
-  quadratic_ = false;
-  since_ = 0;
-  interval_ = 1;
 }
 
 void MobilityReuse::Take(const VecX& x, const MatX& assembled, bool measure) {

@@ -25,10 +25,11 @@
 //
 // SKIPPING. Measuring and keeping D₁, D₂ is a pass over four matrices at each assembly. Where
 // even the quadratic extrapolation misses for two steps (m stays 1: large steps), the next
-// assemblies take 𝕄_c only, 1, 2, 4, then kMaxSkip of them in a row while that repeats; then the
-// history is rebuilt over the next three (D₁, D₂ and the measurement) as after Forget. 𝕄 is assembled at every
-// step either way, so the results are the same; reuse can start at most kMaxSkip + 2 assemblies
-// later than with a measurement at every one.
+// assemblies take 𝕄_c only (the history restarted from each, as the first after Forget), 1, 2,
+// 4, then kMaxSkip of them in a row while that repeats; then the history is rebuilt over the
+// next three (D₁, D₂ and the measurement). 𝕄 is assembled at every step either way, so the
+// results are the same; reuse can start at most kMaxSkip + 2 assemblies later than with a
+// measurement at every one.
 //
 // Measured on paper Fig. 1 at h = 1 ms (t = 0.3 s, assembling at every step for the check): 20
 // steps from a history 8 steps apart miss by 9.5e-5 linearly and 4.0e-6 quadratically; 40 steps
@@ -111,8 +112,6 @@ class MobilityReuse {
   double Position(const VecX& x) const;
   /// Takes the assembled 𝕄(x) into the history; measures the extrapolation's miss when `measure`.
   void Take(const VecX& x, const MatX& assembled, bool measure);
-  /// Takes the assembled 𝕄(x) as 𝕄_c alone: the history starts again from it.
-  void TakeBaseOnly(const VecX& x, const MatX& assembled);
 
   double tolerance_ = 0.0;
   int since_ = 0;      ///< updates since the last assembly
