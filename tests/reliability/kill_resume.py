@@ -97,7 +97,10 @@ def differences(reference, candidate):
                 j["config"]["run"].pop("output")
                 j["config"]["run"].pop("checkpoint_wall_interval", None)
             if ja != jb:
-                problems.append("summary.json differs beyond wall_seconds, mobility_reuse and krylov_products")
+                keys = sorted(k for k in set(ja) | set(jb) if ja.get(k) != jb.get(k))
+                detail = "; ".join(f"{k}: {ja.get(k)} vs {jb.get(k)}" for k in keys)
+                problems.append("summary.json differs beyond wall_seconds, mobility_reuse and "
+                                f"krylov_products ({detail})")
         elif not filecmp.cmp(a, b, shallow=False):
             problems.append(f"{name} differs")
     return problems
@@ -174,6 +177,18 @@ def main():
         problems = differences(reference, out)
         print(f"trial {trial}: {attempts} runs, " + ("identical" if not problems else "; ".join(problems)))
         failures += len(problems)
+    # The latest moment: killed after the last step's checkpoint, before summary.json. A copy of
+    # the finished run without its summary resumes with no step to take.
+    ended = os.path.join(args.work, "ended")
+    shutil.copytree(reference, ended)
+    os.remove(os.path.join(ended, "summary.json"))
+    p = run(args.binary, config, ended, True, common)
+    _, err = p.communicate()
+    if p.returncode != 0:
+        sys.exit(f"the resume after the last checkpoint failed ({p.returncode}): {err.decode()}")
+    problems = differences(reference, ended)
+    print("after the last checkpoint: " + ("identical" if not problems else "; ".join(problems)))
+    failures += len(problems)
     print(f"{kills} interruptions over {args.trials} trials, {failures} failures")
     sys.exit(1 if failures else 0)
 

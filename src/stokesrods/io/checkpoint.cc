@@ -13,8 +13,8 @@ namespace {
 
 constexpr char kMagic[8] = {'S', 'R', 'C', 'K', 'P', 'T', '\0', '\0'};
 // 4: the earlier drags; 5: the bodies' previous poses; 6: the dense 𝕄's reuse history; 7: its
-// skipped measurements
-constexpr std::uint32_t kVersion = 7;
+// skipped measurements; 8: the last row of the time series
+constexpr std::uint32_t kVersion = 8;
 constexpr std::uint32_t kOldestVersion = 2;  // without the controls
 
 std::uint64_t Fnv1a(const char* data, std::size_t bytes, std::uint64_t hash = 14695981039346656037ull) {
@@ -169,6 +169,8 @@ void SaveCheckpoint(const std::string& path, const Model& model, const Checkpoin
   for (const VecX& g : reuse.geometries) w.Vector(g);
   w.Put(static_cast<std::int64_t>(reuse.skip));  // version 7
   w.Put(static_cast<std::int64_t>(reuse.skip_length));
+  w.Put(static_cast<std::int64_t>(c.last_row.size()));  // version 8
+  w.Raw(c.last_row.data(), sizeof(double) * c.last_row.size());
   w.Put(Fnv1a(w.text().data(), w.text().size()));
   WriteFileAtomically(path, w.text());
 }
@@ -257,6 +259,13 @@ Checkpoint LoadCheckpoint(const std::string& path, const Model& model) {
       r.Fail(fmt::format("the reuse's {} of {} skipped measurements is not possible", skip, length));
     reuse.skip = static_cast<int>(skip);
     reuse.skip_length = static_cast<int>(length);
+  }
+  if (version >= 8) {  // the last row of the time series
+    const auto count = r.Get<std::int64_t>();
+    if (count < 0 || static_cast<std::size_t>(count) > (text.size() - r.at()) / sizeof(double))
+      r.Fail(fmt::format("a time-series row of {} values", count));
+    c.last_row.resize(static_cast<std::size_t>(count));
+    r.Raw(c.last_row.data(), sizeof(double) * c.last_row.size());
   }
   if (r.at() + sizeof stored_sum != text.size()) r.Fail("unexpected data after the contents");
   return c;

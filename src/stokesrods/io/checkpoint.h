@@ -56,6 +56,9 @@ struct Checkpoint {
   double time_step = 0.0;  ///< [s] the run's h (a resume must use the same)
   /// Per rod; empty when read from a version 2 file. Saving writes the model's own controls.
   std::vector<RodControls> controls;
+  /// The last row of timeseries.csv at full precision (the CSV holds 12 digits): a run resumed
+  /// at its last step writes the same summary.json. Empty before version 8.
+  std::vector<double> last_row;
 };
 
 /// A hash of what a checkpoint must match: the DOF layout, rest shapes, masses and stiffnesses.

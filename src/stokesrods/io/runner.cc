@@ -43,6 +43,18 @@ class Observer {
     WriteFrame(state, ws);
   }
 
+  /// The last row written, at full precision (the checkpoint keeps it for a resume).
+  const std::vector<double>& last_row() const { return last_row_; }
+
+  /// A resume's last kept row, from the checkpoint at `path`: the summary of a run resumed at
+  /// its last step is that of the run uninterrupted. A checkpoint before version 8 has none.
+  void RestoreLastRow(const std::vector<double>& row, const std::string& path) {
+    if (!row.empty() && row.size() != columns_.size())
+      throw IoError(fmt::format("{}: cannot resume from this checkpoint: its time-series row has "
+                                "{} values, this model writes {}", path, row.size(), columns_.size()));
+    last_row_ = row;
+  }
+
   /// The last row's value of `column` (NaN if there is no such column or no row yet).
   double LastValue(const std::string& column) const {
     for (std::size_t i = 0; i < columns_.size() && i < last_row_.size(); ++i)
@@ -148,7 +160,8 @@ StepReport StepWithHalving(const Model& model, double h, int halvings, State* st
 
 // Resume: the checkpoint into the state, the workspace and the counters; returns the rows kept.
 long Resume(const Config& config, const Model& model, const RunPlan& plan,
-            const std::string& path, State* state, Workspace* ws, RunCounters* counters) {
+            const std::string& path, State* state, Workspace* ws, RunCounters* counters,
+            std::vector<double>* last_row) {
   if (plan.static_mode) throw ConfigError(config.file, "run.mode", "--resume needs a dynamic run");
   if (!fs::exists(path)) throw IoError(fmt::format("{}: no checkpoint to resume from", path));
   Checkpoint c = LoadCheckpoint(path, model);
@@ -164,6 +177,7 @@ long Resume(const Config& config, const Model& model, const RunPlan& plan,
   *state = std::move(c.state);
   RestoreHistory(c.history, ws);
   *counters = c.counters;
+  *last_row = std::move(c.last_row);
   return Schedule{plan}.RowsThrough(state->step);
 }
 
@@ -185,9 +199,12 @@ RunResult RunCase(const Config& config, const RunOptions& options) {
   State& state = sim.state();
   Workspace& ws = sim.workspace();
   RunCounters counters;
-  const long kept_rows =
-      options.resume ? Resume(config, model, plan, checkpoint, &state, &ws, &counters) : 0;
+  std::vector<double> kept_last_row;
+  const long kept_rows = options.resume ? Resume(config, model, plan, checkpoint, &state, &ws,
+                                                 &counters, &kept_last_row)
+                                        : 0;
   Observer observer(config, model, plan, kept_rows);
+  observer.RestoreLastRow(kept_last_row, checkpoint);
   RunResult result;
   result.output_dir = plan.output_dir;
   StepReport report;
@@ -208,7 +225,7 @@ RunResult RunCase(const Config& config, const RunOptions& options) {
   const Schedule schedule{plan};
   long saved_step = -1;
   auto save_checkpoint = [&] {
-    SaveCheckpoint(checkpoint, model, {state, CaptureHistory(ws), counters, h, {}});
+    SaveCheckpoint(checkpoint, model, {state, CaptureHistory(ws), counters, h, {}, observer.last_row()});
     saved_step = state.step;
   };
   if (kept_rows == 0) {
@@ -233,9 +250,20 @@ RunResult RunCase(const Config& config, const RunOptions& options) {
     write_flow();
     save_checkpoint();  // step 0 is a restart point: a run always has a checkpoint
   }
+  // The stop on buckling (run.stop_tip_axis_distance), from the last row: checked after each
+  // recorded step, and on resume (a run resumed where it stopped stops there again).
+  auto buckled = [&]() -> std::optional<std::string> {
+    const double tip = observer.LastValue("rod1_tip_axis_distance");
+    if (!(plan.stop_tip_axis_distance > 0.0 && tip > plan.stop_tip_axis_distance)) return std::nullopt;
+    return fmt::format(
+        "stopped at t_bar = {:.6g}: rod 1 buckled (its last node {:.3g} R off its clamp's vertical)",
+        observer.LastValue("t_bar"), kBuckledTipAxisDistanceOverR * tip / plan.stop_tip_axis_distance);
+  };
   double last_progress = -1.0, last_checkpoint = 0.0;
   bool stopping = false;
-  while (state.step < plan.total_steps) {
+  if (kept_rows > 0)
+    if (std::optional<std::string> stop = buckled()) result.message = *stop;
+  while (state.step < plan.total_steps && result.message.empty()) {
     stopping = stopping || (options.interrupted && options.interrupted());
     const bool stop_now = options.stop_now && options.stop_now();
     if ((stopping && schedule.IsRestartPoint(state.step)) || stop_now) {
@@ -258,12 +286,8 @@ RunResult RunCase(const Config& config, const RunOptions& options) {
     counters.max_penetration = std::max(counters.max_penetration, report.contact.max_penetration);
     if (schedule.Records(state.step)) {
       observer.Record(state, ws, report);
-      const double tip = observer.LastValue("rod1_tip_axis_distance");
-      if (plan.stop_tip_axis_distance > 0.0 && tip > plan.stop_tip_axis_distance) {
-        result.message = fmt::format(
-            "stopped at t_bar = {:.6g}: rod 1 buckled (its last node {:.3g} R off its clamp's vertical)",
-            observer.LastValue("t_bar"),
-            kBuckledTipAxisDistanceOverR * tip / plan.stop_tip_axis_distance);
+      if (std::optional<std::string> stop = buckled()) {
+        result.message = *stop;
         save_checkpoint();
         break;
       }

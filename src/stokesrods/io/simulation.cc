@@ -56,7 +56,7 @@ void Simulation::SaveCheckpoint(const std::string& path) {
   // As a run does at its restart points: forgetting what is reused across steps makes the
   // continuation from here and from the loaded checkpoint the same, digit for digit.
   ForgetReuse(&ws_);
-  stokesrods::SaveCheckpoint(path, model_, {state_, CaptureHistory(ws_), {}, plan_.time_step, {}});
+  stokesrods::SaveCheckpoint(path, model_, {state_, CaptureHistory(ws_), {}, plan_.time_step, {}, {}});
 }
 
 }  // namespace stokesrods
