@@ -149,8 +149,11 @@ TEST(CapacitancePreconditioner, RodBlocksSolveAsTheirDenseLu) {
     const VecX exact = lu.solve(rhs);
     worst = std::max(worst, (y - exact).cwiseAbs().maxCoeff() / exact.cwiseAbs().maxCoeff());
   }
+  // The blocks' factors in half precision (DenseLu kHalf where the CPU allows it, else single):
+  // within a few u = 2⁻¹¹ = 4.9e-4 of the dense LU's solve (measured 4.4e-4; below 1e-4 with
+  // single-precision factors, the bound of before); a wrong block would miss by O(1).
   std::printf("  rod blocks: relative difference from the dense LU %.2e\n", worst);
-  EXPECT_LT(worst, 1e-4);
+  EXPECT_LT(worst, 8.0 * 4.9e-4);
 }
 
 }  // namespace

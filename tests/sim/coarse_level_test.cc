@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include <Eigen/SVD>
@@ -122,12 +123,18 @@ TEST(CoarseLevel, SolveInvertsZTransposeW) {
   const VecX v = VecX::NullaryExpr(ReferenceW(l, false).rows(), [&]() { return normal(rng); });
   const VecX c = coarse.Solve(v);
   const VecX ztv = ZTranspose(6, v);
-  // E is factorized in single precision: LU with partial pivoting is backward stable, the
-  // residual within n ε_float ‖E‖₂ ‖c‖ (n = 72; an E inconsistent with W would miss by O(‖Zᵀv‖)).
+  // E's LU factors are kept in half precision (DenseLu kHalf, where the CPU allows it, else in
+  // single): rounding them perturbs E by at most u |L||U| entrywise, u = 2⁻¹¹ (4.9e-4), which
+  // partial pivoting keeps near u ‖E‖ (the factorization's own single-precision error is 500×
+  // smaller). Residual within 2 u ‖E‖₂ ‖c‖ (measured 0.13 u ‖E‖₂ ‖c‖, which E's conditioning
+  // makes 1.1 % of ‖Zᵀv‖; below 7e-4 of it with single-precision factors, the bound of before);
+  // an E inconsistent with W would miss by O(‖Zᵀv‖).
   const double norm_e = Eigen::JacobiSVD<MatX>(ztw).singularValues()(0);
-  const double bound = 72.0 * 6e-8 * norm_e * c.norm();
-  EXPECT_LT((ztw * c - ztv).norm(), bound);
-  EXPECT_LT(bound, 0.01 * ztv.norm());  // the bound itself says something
+  const double residual = (ztw * c - ztv).norm();
+  std::printf("  coarse solve: residual %.2e of ‖E‖‖c‖, %.2e of ‖Zᵀv‖\n",
+              residual / (norm_e * c.norm()), residual / ztv.norm());
+  EXPECT_LT(residual, 2.0 * 4.9e-4 * norm_e * c.norm());
+  EXPECT_LT(residual, 0.05 * ztv.norm());
   VecX y = VecX::Zero(v.size());
   coarse.AddZ(c, &y);  // Z c: each node takes its chunk's c
   EXPECT_EQ(y.segment<3>(3 * (kNodes + 1)), c.segment<3>(3 * CoarseLevel::kChunksPerRod));

@@ -8,17 +8,29 @@
 #endif
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdlib>
 #include <random>
 #include <string>
 
 #include <Eigen/LU>
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
 
 #include "stokesrods/solver/blas.h"
 #include "stokesrods/solver/lu_solve_avx512.h"
 
+extern "C" void sgetrf_(const int* m, const int* n, float* a, const int* lda, int* ipiv, int* info);
+
 namespace stokesrods {
 namespace {
+
+#if defined(__x86_64__)
+__attribute__((target("f16c"))) float Widen(std::uint16_t h) { return _cvtsh_ss(h); }
+#else
+float Widen(std::uint16_t) { return 0.0f; }
+#endif
 
 template <typename Scalar>
 Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic> RandomMatrix(int n, std::mt19937* rng) {
@@ -106,6 +118,52 @@ TEST(DenseLu, TheBlockedSingleSolveDoesNotDependOnTheThreadCount) {
 #else
   GTEST_SKIP() << "built without OpenMP";
 #endif
+}
+
+// The factors in half precision (LuStorage::kHalf): the half kernel against the single-precision
+// kernel run on the same rounded factors (widened back, U unscaled), to float rounding; and the
+// solve against the single-precision LU's, within the half rounding's effect (2⁻¹¹ per entry on
+// well-conditioned matrices: measured ≤ 1e-3 relative here), on the sizes of
+// TheBlockedSingleSolveMatchesGetrs (from 1024 the parallel panels).
+TEST(DenseLu, HalfPrecisionFactorsSolveLikeTheirSinglePrecisionValues) {
+  if (!HasLuSolveHalfAvx512()) GTEST_SKIP() << "no AVX-512 BW or F16C here: kHalf keeps floats";
+  std::mt19937 rng(12);
+  for (const int n : {1, 5, 31, 32, 33, 64, 65, 195, 390, 1023, 1024, 1100, 2400}) {
+    Eigen::MatrixXf a = RandomMatrix<float>(n, &rng) +
+                        static_cast<float>(2 * n) * Eigen::MatrixXf::Identity(n, n);
+    Eigen::PermutationMatrix<Eigen::Dynamic> shuffle(n);
+    shuffle.setIdentity();
+    std::shuffle(shuffle.indices().data(), shuffle.indices().data() + n, rng);
+    a = shuffle * a * 1e-3f;  // every column pivots; entries far from half precision's 1
+    const Eigen::VectorXf b = RandomMatrix<float>(n, &rng).col(0);
+    DenseLu<float> single, half;
+    ASSERT_TRUE(single.Compute(a));
+    ASSERT_TRUE(half.Compute(a, LuStorage::kHalf));
+    EXPECT_FALSE(single.half());
+    ASSERT_TRUE(half.half());
+    Eigen::VectorXf x_single = b, x_half = b;
+    single.Solve(&x_single);
+    half.Solve(&x_half);
+    const float difference = (x_half - x_single).norm() / x_single.norm();
+    EXPECT_LT(difference, 1e-3f) << n;
+    if (n > 1) EXPECT_GT(difference, 1e-6f) << n;  // the factors were rounded
+
+    // The reference: the same rounded factors, widened, through the single-precision kernel.
+    Eigen::MatrixXf factors = a;
+    std::vector<int> pivots(static_cast<size_t>(n));
+    int info = 0;  // getrf's factors and pivots, as Compute takes them
+    sgetrf_(&n, &n, factors.data(), &n, pivots.data(), &info);
+    ASSERT_EQ(info, 0);
+    std::vector<std::uint16_t> rounded(static_cast<size_t>(n) * static_cast<size_t>(n));
+    float scale = 0.0f;
+    ASSERT_TRUE(ConvertLuToHalf(n, factors.data(), rounded.data(), &scale));
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        factors(i, j) = Widen(rounded[static_cast<size_t>(i + j * n)]) / (i <= j ? scale : 1.0f);
+    Eigen::VectorXf x_reference = b;
+    LuSolveAvx512(n, factors.data(), pivots.data(), x_reference.data());
+    EXPECT_LT((x_half - x_reference).norm(), 1e-5f * x_reference.norm()) << n;
+  }
 }
 
 TEST(DenseLu, ReportsASingularMatrix) {

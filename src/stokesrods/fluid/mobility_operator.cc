@@ -115,8 +115,9 @@ class DenseMobility final : public MobilityOperator {
   const Eigen::MatrixXf* products_ = nullptr;  // 𝕄 the products take in single precision, if so
 };
 
-// out (compressed rows) from the blocks per target, packed in parallel.
-void PackNearBlocks(const std::vector<std::vector<std::pair<int, Mat3>>>& per_target,
+// out (compressed rows) from the blocks per target, packed in parallel (in single precision if
+// `single`).
+void PackNearBlocks(const std::vector<std::vector<std::pair<int, Mat3>>>& per_target, bool single,
                     NearBlocks* out) {
   const int m = static_cast<int>(per_target.size());
   out->start.resize(static_cast<size_t>(m) + 1);
@@ -124,14 +125,20 @@ void PackNearBlocks(const std::vector<std::vector<std::pair<int, Mat3>>>& per_ta
   for (int t = 0; t < m; ++t)
     out->start[static_cast<size_t>(t) + 1] =
         out->start[static_cast<size_t>(t)] + static_cast<int>(per_target[static_cast<size_t>(t)].size());
-  out->source.resize(static_cast<size_t>(out->start.back()));
-  out->block.resize(static_cast<size_t>(out->start.back()));
+  const auto count = static_cast<size_t>(out->start.back());
+  out->source.resize(count);
+  out->single = single;
+  out->block.resize(single ? 0 : count);
+  out->block_single.resize(single ? count : 0);
 #pragma omp parallel for schedule(static)
   for (int t = 0; t < m; ++t) {
     auto k = static_cast<size_t>(out->start[static_cast<size_t>(t)]);
     for (const auto& [node, block] : per_target[static_cast<size_t>(t)]) {
       out->source[k] = node;
-      out->block[k++] = block;
+      if (single)
+        out->block_single[k++] = block.cast<float>();
+      else
+        out->block[k++] = block;
     }
   }
 }
@@ -176,7 +183,7 @@ class MatrixFreeRssMobility final : public MobilityOperator {
   void FindNearBlocks(const Matrix3X& targets, NearBlocks* blocks) const override;
   MobilityCostCounts cost_counts() const override {
     const double far_cost = use_rule_sum_ ? static_cast<double>(rule_sum_.pairs()) : far_->Stats().cost;
-    return {static_cast<std::int64_t>(near_.block.size()), far_cost, split_.gauss_points};
+    return {static_cast<std::int64_t>(near_.size()), far_cost, split_.gauss_points};
   }
 
  private:
@@ -348,7 +355,7 @@ void MatrixFreeRssMobility::FindNearBlocks(const Matrix3X& targets, NearBlocks* 
       }
     }
   }
-  PackNearBlocks(per_target_, out);
+  PackNearBlocks(per_target_, single_far_, out);
 }
 
 void MatrixFreeRssMobility::NearPairBlocks(const Vec3& p, const std::vector<int>& near,

@@ -112,7 +112,8 @@ bool CapacitancePreconditioner::Build(const Model& model, double h,
 #pragma omp parallel for schedule(dynamic) reduction(&& : ok)
   for (int k = 0; k < num_blocks; ++k) {
     Block& block = blocks_[static_cast<size_t>(k)];
-    ok = block.lu.Compute(BlockMatrix(model, h, block, rod_blocks, rods, bodies).cast<float>()) &&
+    ok = block.lu.Compute(BlockMatrix(model, h, block, rod_blocks, rods, bodies).cast<float>(),
+                          LuStorage::kHalf) &&
          ok;
   }
   if (!ok) return false;

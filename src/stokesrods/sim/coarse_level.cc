@@ -116,7 +116,7 @@ bool CoarseLevel::Build(const std::vector<CoarseRod>& rods, const std::vector<Ma
       for (int k = near_start_[static_cast<size_t>(i)]; k < near_start_[static_cast<size_t>(i) + 1]; ++k)
         e.block<3, 3>(3 * a, 3 * near_chunk_[static_cast<size_t>(k)]) += near_block_[static_cast<size_t>(k)];
   }
-  const bool regular = lu_.Compute(e.cast<float>());
+  const bool regular = lu_.Compute(e.cast<float>(), LuStorage::kHalf);
 
   // between_ sums every chunk, the own rod's too: take the own centroids' Stokeslets out of own_
   // (after E, which has the exact own blocks), so that W c = own_ c_k + between_.

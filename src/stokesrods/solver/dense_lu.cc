@@ -32,24 +32,39 @@ void Getrs(int n, const double* a, const int* ipiv, double* b, int* info) {
 }  // namespace
 
 template <typename Scalar>
-bool DenseLu<Scalar>::Compute(Matrix a) {
+bool DenseLu<Scalar>::Compute(Matrix a, LuStorage storage) {
   SR_ASSERT(a.rows() == a.cols(), "DenseLu: the matrix must be square");
+  SR_ASSERT((storage == LuStorage::kNative || std::is_same_v<Scalar, float>),
+            "DenseLu: half precision storage is for single precision factors");
   lu_ = std::move(a);
-  const int n = static_cast<int>(lu_.rows());
+  half_.clear();
+  n_ = lu_.rows();
+  const int n = static_cast<int>(n_);
   pivots_.resize(static_cast<std::size_t>(n));
   if (n == 0) return true;
   int info = 0;
   Getrf(n, lu_.data(), pivots_.data(), &info);
   SR_ASSERT(info >= 0, "DenseLu: bad argument to getrf");
+  if constexpr (std::is_same_v<Scalar, float>) {
+    if (info == 0 && storage == LuStorage::kHalf && HasLuSolveHalfAvx512()) {
+      half_.resize(static_cast<std::size_t>(lu_.size()));
+      if (ConvertLuToHalf(n, lu_.data(), half_.data(), &half_scale_))
+        lu_ = Matrix();  // the single-precision factors are not kept
+      else
+        half_.clear();
+    }
+  }
   return info == 0;
 }
 
 template <typename Scalar>
 void DenseLu<Scalar>::Solve(Vector* b, bool use_lapack) const {
-  SR_ASSERT(b->size() == lu_.rows(), "DenseLu: right-hand side of the wrong size");
-  const int n = static_cast<int>(lu_.rows());
+  SR_ASSERT(b->size() == n_, "DenseLu: right-hand side of the wrong size");
+  const int n = static_cast<int>(n_);
   if (n == 0) return;
   if constexpr (std::is_same_v<Scalar, float>) {
+    if (!half_.empty())
+      return LuSolveHalfAvx512(n, half_.data(), pivots_.data(), half_scale_, b->data());
     if (!use_lapack && HasLuSolveAvx512())
       return LuSolveAvx512(n, lu_.data(), pivots_.data(), b->data());
   }
@@ -60,8 +75,10 @@ void DenseLu<Scalar>::Solve(Vector* b, bool use_lapack) const {
 
 template <typename Scalar>
 void DenseLu<Scalar>::Prefetch() const {
-  const char* p = reinterpret_cast<const char*>(lu_.data());
-  const std::size_t bytes = sizeof(Scalar) * static_cast<std::size_t>(lu_.size());
+  const char* p = half_.empty() ? reinterpret_cast<const char*>(lu_.data())
+                                : reinterpret_cast<const char*>(half_.data());
+  const std::size_t bytes = half_.empty() ? sizeof(Scalar) * static_cast<std::size_t>(lu_.size())
+                                          : sizeof(std::uint16_t) * half_.size();
   for (std::size_t b = 0; b < bytes; b += 64) __builtin_prefetch(p + b, 0, 2);
 }
 

@@ -5,11 +5,21 @@
 // Single precision for preconditioners (half the memory each solve streams), double otherwise.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
 
 namespace stokesrods {
+
+/// How DenseLu<float> keeps its factors for the solves.
+enum class LuStorage {
+  kNative,  ///< as getrf leaves them
+  /// In IEEE half precision (U scaled by a power of two; lu_solve_avx512.h) where the CPU has
+  /// AVX-512 BW and F16C, else as kNative: half the bytes each solve streams, for preconditioners
+  /// of many blocks whose factors do not stay in cache (a relative rounding of 2⁻¹¹ per entry).
+  kHalf,
+};
 
 template <typename Scalar>
 class DenseLu {
@@ -17,19 +27,25 @@ class DenseLu {
   using Matrix = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
   using Vector = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
 
-  /// Factorizes a (square). False if it is exactly singular (a zero pivot).
-  bool Compute(Matrix a);
+  /// Factorizes a (square). False if it is exactly singular (a zero pivot). `storage` kHalf is
+  /// for single precision only.
+  bool Compute(Matrix a, LuStorage storage = LuStorage::kNative);
+  /// Whether the factors are kept in half precision (kHalf where the CPU allows it).
+  bool half() const { return !half_.empty(); }
   /// x = A⁻¹ b in place (b's size must be the matrix's). In single precision on AVX-512 by a
   /// blocked substitution of our own (lu_solve_avx512.cc: 8.7 against getrs's 12.1 µs at
   /// n = 390, bench_step BM_FloatLuSolve), else by getrs; `use_lapack` forces getrs (tests).
   void Solve(Vector* b, bool use_lapack = false) const;
-  Eigen::Index size() const { return lu_.rows(); }
+  Eigen::Index size() const { return n_; }
   /// Asks the CPU to bring the factors into its L2 cache ahead of a Solve (no effect on results).
   void Prefetch() const;
 
  private:
-  Matrix lu_;
+  Matrix lu_;  ///< empty when the factors are in half_
   std::vector<int> pivots_;
+  Eigen::Index n_ = 0;
+  std::vector<std::uint16_t> half_;
+  float half_scale_ = 1.0f;  ///< U's factor in half_
 };
 
 extern template class DenseLu<float>;

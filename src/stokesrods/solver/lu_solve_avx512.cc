@@ -9,6 +9,8 @@
 #include <immintrin.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <utility>
 
 #include <Eigen/Core>
@@ -146,9 +148,196 @@ bool HasLuSolveAvx512() {
   return has;
 }
 
+// HALF PRECISION. The factors of preconditioners whose solves stream them from memory (a hundred
+// rods' blocks, 15 MB in single precision; the coarse level's E, 23 MB) kept in half precision:
+// half the bytes per solve. Each kernel above has its twin here that widens 16 entries at a time
+// (vcvtph2ps) as it loads them; the arithmetic and its order are those of the single-precision
+// kernels on the rounded factors.
+#define SR_HALF __attribute__((target("avx512f,avx512bw,avx512vl,f16c")))
+// (GCC 12's avx512fintrin.h warns on its own _mm512_undefined_ps in vcvtph2ps, GCC bug 105593.)
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+namespace {
+
+SR_HALF inline __m512 LoadHalf(__mmask16 m, const std::uint16_t* p) {
+  return _mm512_cvtph_ps(_mm256_maskz_loadu_epi16(m, p));
+}
+SR_HALF inline float HalfToFloat(std::uint16_t h) { return _cvtsh_ss(h); }
+inline __mmask16 Lanes(int count) {  // the first min(count, 16) lanes, none if count ≤ 0
+  return static_cast<__mmask16>((1u << std::clamp(count, 0, 16)) - 1u);
+}
+
+// y[0, count) −= x · c[0, count), count ≤ 32 (the small triangles of the blocks).
+SR_HALF inline void AxpyHalfShort(int count, const std::uint16_t* c, float x, float* y) {
+  const __m512 xv = _mm512_set1_ps(x);
+  for (int i = 0; i < count; i += 16) {
+    const __mmask16 m = Lanes(count - i);
+    const __m512 yv = _mm512_maskz_loadu_ps(m, y + i);
+    _mm512_mask_storeu_ps(y + i, m, _mm512_fnmadd_ps(LoadHalf(m, c + i), xv, yv));
+  }
+}
+
+// SubtractPanel on half-precision columns.
+SR_HALF inline void SubtractPanelHalf(int rows, int cols, const std::uint16_t* p, Eigen::Index ld,
+                                      const float* x, float* y) {
+  for (int i0 = 0; i0 < rows; i0 += 64) {
+    const __mmask16 m0 = Lanes(rows - i0), m1 = Lanes(rows - i0 - 16), m2 = Lanes(rows - i0 - 32),
+                    m3 = Lanes(rows - i0 - 48);
+    float* out = y + i0;
+    __m512 a0 = _mm512_maskz_loadu_ps(m0, out), a1 = _mm512_maskz_loadu_ps(m1, out + 16),
+           a2 = _mm512_maskz_loadu_ps(m2, out + 32), a3 = _mm512_maskz_loadu_ps(m3, out + 48);
+    for (int j = 0; j < cols; ++j) {
+      const __m512 xj = _mm512_set1_ps(x[j]);
+      const std::uint16_t* column = p + j * ld + i0;
+      a0 = _mm512_fnmadd_ps(LoadHalf(m0, column), xj, a0);
+      a1 = _mm512_fnmadd_ps(LoadHalf(m1, column + 16), xj, a1);
+      a2 = _mm512_fnmadd_ps(LoadHalf(m2, column + 32), xj, a2);
+      a3 = _mm512_fnmadd_ps(LoadHalf(m3, column + 48), xj, a3);
+    }
+    _mm512_mask_storeu_ps(out, m0, a0);
+    _mm512_mask_storeu_ps(out + 16, m1, a1);
+    _mm512_mask_storeu_ps(out + 32, m2, a2);
+    _mm512_mask_storeu_ps(out + 48, m3, a3);
+  }
+}
+
+// SubtractColumns on half-precision columns: y[0, rows) −= Σ_j x_j p(:, j), four columns per pass.
+SR_HALF inline void SubtractColumnsHalf(int rows, int cols, const std::uint16_t* p, Eigen::Index ld,
+                                        const float* x, float* y) {
+  int j = 0;
+  for (; j + 4 <= cols; j += 4) {
+    const __m512 x0 = _mm512_set1_ps(x[j]), x1 = _mm512_set1_ps(x[j + 1]),
+                 x2 = _mm512_set1_ps(x[j + 2]), x3 = _mm512_set1_ps(x[j + 3]);
+    const std::uint16_t *c0 = p + j * ld, *c1 = c0 + ld, *c2 = c1 + ld, *c3 = c2 + ld;
+    for (int i = 0; i < rows; i += 16) {
+      const __mmask16 m = Lanes(rows - i);
+      __m512 a = _mm512_maskz_loadu_ps(m, y + i);
+      a = _mm512_fnmadd_ps(LoadHalf(m, c0 + i), x0, a);
+      a = _mm512_fnmadd_ps(LoadHalf(m, c1 + i), x1, a);
+      a = _mm512_fnmadd_ps(LoadHalf(m, c2 + i), x2, a);
+      a = _mm512_fnmadd_ps(LoadHalf(m, c3 + i), x3, a);
+      _mm512_mask_storeu_ps(y + i, m, a);
+    }
+  }
+  for (; j < cols; ++j) {
+    const __m512 xj = _mm512_set1_ps(x[j]);
+    const std::uint16_t* column = p + j * ld;
+    for (int i = 0; i < rows; i += 16) {
+      const __mmask16 m = Lanes(rows - i);
+      const __m512 a = _mm512_maskz_loadu_ps(m, y + i);
+      _mm512_mask_storeu_ps(y + i, m, _mm512_fnmadd_ps(LoadHalf(m, column + i), xj, a));
+    }
+  }
+}
+
+SR_HALF void LuSolveHalfParallel(int n, const std::uint16_t* lu, const int* pivots, float u_scale,
+                                 float* x) {
+  for (int i = 0; i < n; ++i)
+    if (pivots[i] - 1 != i) std::swap(x[i], x[pivots[i] - 1]);
+  const Eigen::Index ld = n;
+#pragma omp parallel
+  {
+    for (int j0 = 0; j0 < n; j0 += kWideBlock) {  // L (unit diagonal), from the top
+      const int j1 = std::min(j0 + kWideBlock, n);
+#pragma omp single
+      for (int j = j0; j < j1; ++j)
+        SubtractColumnsHalf(j1 - j - 1, 1, lu + j + 1 + j * ld, ld, x + j, x + j + 1);
+#pragma omp for schedule(static)
+      for (int r = j1; r < n; r += kChunkRows)
+        SubtractColumnsHalf(std::min(kChunkRows, n - r), j1 - j0, lu + r + j0 * ld, ld, x + j0,
+                            x + r);
+    }
+#pragma omp for schedule(static)
+    for (int i = 0; i < n; ++i) x[i] *= u_scale;
+    for (int j1 = n; j1 > 0; j1 -= kWideBlock) {  // U, from the bottom
+      const int j0 = std::max(j1 - kWideBlock, 0);
+#pragma omp single
+      for (int j = j1 - 1; j >= j0; --j) {
+        x[j] /= HalfToFloat(lu[j + j * ld]);
+        SubtractColumnsHalf(j - j0, 1, lu + j0 + j * ld, ld, x + j, x + j0);
+      }
+#pragma omp for schedule(static)
+      for (int r = 0; r < j0; r += kChunkRows)
+        SubtractColumnsHalf(std::min(kChunkRows, j0 - r), j1 - j0, lu + r + j0 * ld, ld, x + j0,
+                            x + r);
+    }
+  }
+}
+
+}  // namespace
+
+SR_HALF bool ConvertLuToHalf(int n, const float* lu, std::uint16_t* half, float* u_scale) {
+  const Eigen::Index ld = n;
+  float largest = 0.0f;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i <= j; ++i) largest = std::max(largest, std::abs(lu[i + j * ld]));
+  if (!std::isfinite(largest)) return false;
+  const float scale = largest > 0.0f ? std::ldexp(1.0f, 14 - std::ilogb(largest)) : 1.0f;
+  const __m512i lane = _mm512_set_epi32(15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0);
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; i += 16) {
+      const __mmask16 m = Lanes(n - i);
+      // Rows i … i + 15 of column j: U (row ≤ j) scaled, L as it is.
+      const __mmask16 upper =
+          _mm512_cmple_epi32_mask(_mm512_add_epi32(lane, _mm512_set1_epi32(i)), _mm512_set1_epi32(j));
+      __m512 v = _mm512_maskz_loadu_ps(m, lu + i + j * ld);
+      v = _mm512_mask_mul_ps(v, upper, v, _mm512_set1_ps(scale));
+      _mm256_mask_storeu_epi16(half + i + j * ld, m,
+                               _mm512_cvtps_ph(v, _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC));
+    }
+  }
+  *u_scale = scale;
+  return true;
+}
+
+SR_HALF void LuSolveHalfAvx512(int n, const std::uint16_t* lu, const int* pivots, float u_scale,
+                               float* x) {
+  if (n >= kParallelLuSolve) return LuSolveHalfParallel(n, lu, pivots, u_scale, x);
+  for (int i = 0; i < n; ++i)
+    if (pivots[i] - 1 != i) std::swap(x[i], x[pivots[i] - 1]);
+  const Eigen::Index ld = n;
+  for (int j0 = 0; j0 < n; j0 += kBlock) {  // L (unit diagonal), blocks from the top
+    const int j1 = std::min(j0 + kBlock, n);
+    for (int j = j0; j < j1; ++j) AxpyHalfShort(j1 - j - 1, lu + j + 1 + j * ld, x[j], x + j + 1);
+    SubtractPanelHalf(n - j1, j1 - j0, lu + j1 + j0 * ld, ld, x + j0, x + j1);
+  }
+  for (int i = 0; i < n; ++i) x[i] *= u_scale;  // U's factors are scaled: U' x = scale y
+  for (int j1 = n; j1 > 0; j1 -= kBlock) {  // U, blocks from the bottom
+    const int j0 = std::max(j1 - kBlock, 0);
+    for (int j = j1 - 1; j >= j0; --j) {
+      const float xj = x[j] / HalfToFloat(lu[j + j * ld]);
+      x[j] = xj;
+      AxpyHalfShort(j - j0, lu + j0 + j * ld, xj, x + j0);
+    }
+    SubtractPanelHalf(j0, j1 - j0, lu + j0 * ld, ld, x + j0, x);
+  }
+}
+
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
+
+bool HasLuSolveHalfAvx512() {
+  static const bool has = __builtin_cpu_supports("avx512f") &&
+                          __builtin_cpu_supports("avx512bw") &&
+                          __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("f16c");
+  return has;
+}
+#undef SR_HALF
+
 #else
 void LuSolveAvx512(int, const float*, const int*, float*) {}
 bool HasLuSolveAvx512() { return false; }
+bool ConvertLuToHalf(int, const float*, std::uint16_t*, float*) { return false; }
+void LuSolveHalfAvx512(int, const std::uint16_t*, const int*, float, float*) {}
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
+
+bool HasLuSolveHalfAvx512() { return false; }
 #endif
 
 }  // namespace stokesrods
