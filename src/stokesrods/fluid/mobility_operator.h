@@ -51,10 +51,16 @@ struct NearBlocks {
   Vec3 At(int t, const VecX& force) const {
     Vec3 u = Vec3::Zero();
     const int begin = start[static_cast<size_t>(t)], end = start[static_cast<size_t>(t) + 1];
-    if (single) {
-      for (int k = begin; k < end; ++k)
-        u += block_single[static_cast<size_t>(k)].cast<double>() *
-             force.segment<3>(3 * source[static_cast<size_t>(k)]);
+    if (single) {  // written out: Eigen's mixed product goes through a temporary and a loop
+      double ux = 0.0, uy = 0.0, uz = 0.0;
+      for (int k = begin; k < end; ++k) {
+        const float* b = block_single[static_cast<size_t>(k)].data();  // column-major
+        const double* f = force.data() + 3 * source[static_cast<size_t>(k)];
+        ux += double(b[0]) * f[0] + double(b[3]) * f[1] + double(b[6]) * f[2];
+        uy += double(b[1]) * f[0] + double(b[4]) * f[1] + double(b[7]) * f[2];
+        uz += double(b[2]) * f[0] + double(b[5]) * f[1] + double(b[8]) * f[2];
+      }
+      u = Vec3(ux, uy, uz);
     } else {
       for (int k = begin; k < end; ++k)
         u += block[static_cast<size_t>(k)] * force.segment<3>(3 * source[static_cast<size_t>(k)]);
