@@ -146,7 +146,9 @@ TEST(DenseLu, HalfPrecisionFactorsSolveLikeTheirSinglePrecisionValues) {
     half.Solve(&x_half);
     const float difference = (x_half - x_single).norm() / x_single.norm();
     EXPECT_LT(difference, 1e-3f) << n;
-    if (n > 1) EXPECT_GT(difference, 1e-6f) << n;  // the factors were rounded
+    if (n > 1) {
+      EXPECT_GT(difference, 1e-6f) << n;  // the factors were rounded
+    }
 
     // The reference: the same rounded factors, widened, through the single-precision kernel.
     Eigen::MatrixXf factors = a;

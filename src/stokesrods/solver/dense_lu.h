@@ -35,6 +35,7 @@ class DenseLu {
   /// x = A⁻¹ b in place (b's size must be the matrix's). In single precision on AVX-512 by a
   /// blocked substitution of our own (lu_solve_avx512.cc: 8.7 against getrs's 12.1 µs at
   /// n = 390, bench_step BM_FloatLuSolve), else by getrs; `use_lapack` forces getrs (tests).
+  /// Factors in half precision are always solved by their own kernel (lu_solve_avx512.h).
   void Solve(Vector* b, bool use_lapack = false) const;
   Eigen::Index size() const { return n_; }
   /// Asks the CPU to bring the factors into its L2 cache ahead of a Solve (no effect on results).

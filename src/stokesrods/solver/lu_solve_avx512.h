@@ -22,7 +22,7 @@ bool ConvertLuToHalf(int n, const float* lu, std::uint16_t* half, float* u_scale
 /// rounded factors, to single-precision rounding. Precondition: HasLuSolveHalfAvx512().
 void LuSolveHalfAvx512(int n, const std::uint16_t* half, const int* pivots, float u_scale,
                        float* x);
-/// True when the CPU has AVX-512 F, BW and VL and F16C (the half precision loads).
+/// True when the CPU has AVX-512 F, BW and VL (and so F16C): the half precision loads.
 bool HasLuSolveHalfAvx512();
 
 }  // namespace stokesrods
