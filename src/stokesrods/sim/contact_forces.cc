@@ -32,9 +32,12 @@ std::string DescribeDeepest(const ContactSummary& summary) {
 
 int SelfContactExclusion(const RodModel& rod) {
   // Two segments of one rod that are fewer than this many edges apart cannot reach each other
-  // without folding the rod tighter than its own diameter; adjacent ones always touch.
+  // without folding the rod tighter than its own diameter; adjacent ones always touch. At most
+  // the rod's edge count (then no pair of its own is tested): a radius far beyond the edges (the
+  // fuzzer's 1e7 m on 5 mm edges) would overflow an int.
+  const auto edges = static_cast<double>(rod.rest_edge_length.size());
   const double shortest = rod.rest_edge_length.minCoeff();
-  return static_cast<int>(std::ceil(2.0 * rod.radius / shortest)) + 1;
+  return static_cast<int>(std::min(std::ceil(2.0 * rod.radius / shortest) + 1.0, std::max(edges, 1.0)));
 }
 
 namespace {
