@@ -9,6 +9,7 @@
 #include "common/helix_lattice.h"
 #include "stokesrods/contact/broad_phase.h"
 #include "stokesrods/contact/segment_distance.h"
+#include "stokesrods/fluid/mobility_reuse_avx512.h"
 #include "stokesrods/io/build_model.h"
 #include "stokesrods/io/config.h"
 #include "stokesrods/sim/elastic_assembly.h"
@@ -151,6 +152,38 @@ void BM_MobilityProduct(benchmark::State& st, bool single) {
 }
 BENCHMARK_CAPTURE(BM_MobilityProduct, double, false)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_MobilityProduct, single_double_sums, true)->Unit(benchmark::kMicrosecond);
+
+// One step's pass of the dense 𝕄's reuse on Fig. 1 (3M = 390, fluid/mobility_reuse.h): forming
+// 𝕄 = 𝕄_c + s D₁ + c D₂ with D₁, D₂ in single precision (the portable pass, here for AVX-512 F)
+// or in half precision (fluid/mobility_reuse_avx512.h).
+__attribute__((target("avx512f"))) void ExtrapolateSingle(Eigen::Index n, const float* base,
+                                                          float s, const float* slope, float c,
+                                                          const float* curve, float* out) {
+#pragma omp simd
+  for (Eigen::Index i = 0; i < n; ++i) out[i] = base[i] + s * slope[i] + c * curve[i];
+}
+void BM_ReuseExtrapolate(benchmark::State& st, bool half) {
+  if (!HasReuseHalfAvx512()) return st.SkipWithError("no AVX-512 BW on this CPU");
+  const int n = 390;
+  const Eigen::MatrixXf base = Eigen::MatrixXf::Random(n, n);
+  Eigen::MatrixXf slope = 1e-2f * Eigen::MatrixXf::Random(n, n);
+  Eigen::MatrixXf curve = 1e-4f * Eigen::MatrixXf::Random(n, n);
+  std::vector<std::uint16_t> slope_half(static_cast<std::size_t>(n) * n), curve_half(slope_half);
+  const float slope_scale = RoundToHalfAvx512(slope.size(), slope.data(), slope_half.data());
+  const float curve_scale = RoundToHalfAvx512(curve.size(), curve.data(), curve_half.data());
+  Eigen::MatrixXf out(n, n);
+  const float s = 0.37f, c = s * (s + 1.0f);
+  for (auto _ : st) {
+    if (half)
+      ExtrapolateHalfAvx512(out.size(), base.data(), s / slope_scale, slope_half.data(),
+                            c / curve_scale, curve_half.data(), out.data());
+    else
+      ExtrapolateSingle(out.size(), base.data(), s, slope.data(), c, curve.data(), out.data());
+    benchmark::DoNotOptimize(out.data());
+  }
+}
+BENCHMARK_CAPTURE(BM_ReuseExtrapolate, single, false)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_ReuseExtrapolate, half, true)->Unit(benchmark::kMicrosecond);
 
 // The preconditioner's solve of one vector with a float LU of size n: Fig. 1's C (3M = 390) and
 // the coarse level's E on 100 helices (2400; from 1024 on, the panels over the OpenMP threads):

@@ -5,11 +5,15 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <random>
 
 #include <Eigen/Geometry>
 
 #include "stokesrods/fluid/mobility_operator.h"
+#include "stokesrods/fluid/mobility_reuse_avx512.h"
 #include "stokesrods/fluid/rss.h"
 #include "stokesrods/rod/geometry.h"
 #include "stokesrods/solver/blas.h"
@@ -294,6 +298,132 @@ TEST(MobilityReuse, RestoredHistoryOfAnotherSizeIsDropped) {
   EXPECT_EQ(op->reuse_stats().assemblies, 1);
   EXPECT_EQ((*op->matrix() - exact).cwiseAbs().maxCoeff(), 0.0);
   EXPECT_EQ(op->reuse_history().geometries.size(), 1u);
+}
+
+// IEEE half precision to single, decoded bit by bit (the reference for the kernels' vcvtph2ps).
+float DecodeHalf(std::uint16_t h) {
+  const int exponent = (h >> 10) & 0x1f, mantissa = h & 0x3ff;
+  const float sign = (h & 0x8000) ? -1.0f : 1.0f;
+  if (exponent == 0) return sign * std::ldexp(static_cast<float>(mantissa), -24);
+  if (exponent == 31) return mantissa ? NAN : sign * INFINITY;
+  return sign * std::ldexp(static_cast<float>(1024 + mantissa), exponent - 25);
+}
+
+// Entries over nine decades, with signs and zeros, n = 1 … 1000 (the kernels' masked tails): each
+// is replaced by what its half value stands for (the decoded half over the scale, exactly), within
+// half precision's rounding (2⁻¹¹ relative in its normal range, 2⁻²⁵ of the scale below it); the
+// scale is the power of two that puts the largest entry in [2¹⁴, 2¹⁵).
+TEST(MobilityReuseHalf, RoundsToWhatTheHalfValuesStandFor) {
+  if (!HasReuseHalfAvx512()) GTEST_SKIP() << "no AVX-512 BW on this CPU";
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> decade(-7.0f, 2.0f), unit(-1.0f, 1.0f);
+  for (const int n : {1, 15, 16, 17, 1000}) {
+    std::vector<float> d(static_cast<std::size_t>(n));
+    for (float& v : d) v = unit(random) * std::pow(10.0f, decade(random));
+    if (n > 2) d[1] = 0.0f;
+    const std::vector<float> before = d;
+    std::vector<std::uint16_t> half(d.size());
+    const float scale = RoundToHalfAvx512(n, d.data(), half.data());
+    float largest = 0.0f;
+    for (const float v : before) largest = std::max(largest, std::abs(v));
+    EXPECT_EQ(std::ldexp(1.0f, std::ilogb(scale)), scale) << "a power of two";
+    EXPECT_GE(largest * scale, 16384.0f);
+    EXPECT_LT(largest * scale, 32768.0f);
+    for (std::size_t i = 0; i < d.size(); ++i) {
+      ASSERT_EQ(d[i], DecodeHalf(half[i]) / scale) << "n " << n << " entry " << i;
+      const float bound = std::max(std::abs(before[i]) * std::ldexp(1.0f, -11),
+                                   std::ldexp(1.0f, -25) / scale);
+      ASSERT_LE(std::abs(d[i] - before[i]), bound) << "n " << n << " entry " << i;
+    }
+  }
+  std::vector<float> zeros(20, 0.0f);
+  std::vector<std::uint16_t> half(20, 0xffff);
+  EXPECT_EQ(RoundToHalfAvx512(20, zeros.data(), half.data()), 1.0f);
+  EXPECT_EQ(half[19], 0);
+  for (const float bad : {NAN, INFINITY}) {
+    std::vector<float> d(40, 1.0f);
+    d[33] = bad;
+    std::vector<std::uint16_t> untouched(40, 0x1234);
+    EXPECT_EQ(RoundToHalfAvx512(40, d.data(), untouched.data()), 0.0f);
+    EXPECT_EQ(untouched[0], 0x1234);
+    EXPECT_EQ(d[0], 1.0f);
+  }
+}
+
+// The extrapolation from half-precision differences is base + a · slope + b · curve on the
+// decoded values, to single precision's rounding of the sum (with and without the curve; n with
+// masked tails).
+TEST(MobilityReuseHalf, ExtrapolatesTheDecodedDifferences) {
+  if (!HasReuseHalfAvx512()) GTEST_SKIP() << "no AVX-512 BW on this CPU";
+  std::mt19937 random(11);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  for (const int n : {5, 16, 390 * 390}) {
+    std::vector<float> base(static_cast<std::size_t>(n)), slope(base), curve(base), out(base);
+    for (std::size_t i = 0; i < base.size(); ++i)
+      base[i] = unit(random), slope[i] = 1e-2f * unit(random), curve[i] = 1e-4f * unit(random);
+    std::vector<std::uint16_t> slope_half(base.size()), curve_half(base.size());
+    const float s1 = RoundToHalfAvx512(n, slope.data(), slope_half.data());
+    const float s2 = RoundToHalfAvx512(n, curve.data(), curve_half.data());
+    for (const bool quadratic : {false, true}) {
+      const float a = 0.37f, b = quadratic ? 0.37f * 1.37f : 0.0f;
+      ExtrapolateHalfAvx512(n, base.data(), a / s1, slope_half.data(), b / s2,
+                            quadratic ? curve_half.data() : nullptr, out.data());
+      double worst = 0.0;
+      for (std::size_t i = 0; i < base.size(); ++i) {
+        const double exact = static_cast<double>(base[i]) + static_cast<double>(a) * slope[i] +
+                             (quadratic ? static_cast<double>(b) * curve[i] : 0.0);
+        worst = std::max(worst, std::abs(out[i] - exact) /
+                                    (std::abs(base[i]) + std::abs(a * slope[i]) + 1e-30));
+      }
+      EXPECT_LT(worst, 2.0 * std::ldexp(1.0, -24)) << "n " << n << " quadratic " << quadratic;
+    }
+  }
+}
+
+// The reuse with D₁, D₂ in half precision against the same reuse in single precision, on the
+// motion of Fig. 1 at h = 1 ms (1.6e-3 rad per step): while the two hold the same assemblies
+// their extrapolated 𝕄 differ by half's rounding of s D₁ + c D₂ (2⁻¹¹ of them, with ‖D₁‖ about
+// the interval's change of 𝕄, ~1e-2: ≤ 1e-5 of 𝕄), both stay within the tolerance, and the
+// half one assembles about as often (its error measured on the values it uses).
+TEST(MobilityReuseHalf, ExtrapolatesAsTheSinglePrecisionHistoryWithinTheTolerance) {
+  if (!HasReuseHalfAvx512()) GTEST_SKIP() << "no AVX-512 BW on this CPU";
+  const double tolerance = 1e-4;
+  FluidParams params;
+  MobilityReuse half(tolerance, true), single(tolerance, false);
+  double worst_half = 0.0, worst_single = 0.0, worst_apart = 0.0;
+  int compared = 0;
+  for (int k = 0; k < 200; ++k) {
+    const std::vector<Matrix3X> x = TurnedHelices(1.6e-3 * k);
+    const auto assemble_at = [&](const VecX& at, MatX* m) {
+      std::vector<Matrix3X> moved = {Eigen::Map<const Matrix3X>(at.data(), 3, 33),
+                                     Eigen::Map<const Matrix3X>(at.data() + 99, 3, 33)};
+      AssembleMobility(params, Rods(moved), m);
+    };
+    VecX at(198);
+    at << x[0].reshaped(), x[1].reshaped();
+    MatX exact, assembled_half, assembled_single;
+    assemble_at(at, &exact);
+    Eigen::MatrixXf from_half, from_single;
+    const bool assembled_h = half.Update(at, assemble_at, &assembled_half, &from_half);
+    const bool assembled_s = single.Update(at, assemble_at, &assembled_single, &from_single);
+    const double norm = exact.norm();
+    if (!assembled_h) worst_half = std::max(worst_half, (from_half.cast<double>() - exact).norm() / norm);
+    if (!assembled_s)
+      worst_single = std::max(worst_single, (from_single.cast<double>() - exact).norm() / norm);
+    if (!assembled_h && !assembled_s && half.stats().assemblies == single.stats().assemblies) {
+      worst_apart = std::max(worst_apart, (from_half - from_single).cast<double>().norm() / norm);
+      ++compared;
+    }
+  }
+  std::printf("  half: %ld assemblies, worst error %.2e; single: %ld, %.2e; apart by %.2e over "
+              "%d steps\n", half.stats().assemblies, worst_half, single.stats().assemblies,
+              worst_single, worst_apart, compared);
+  EXPECT_GT(compared, 20);
+  EXPECT_GT(worst_apart, 0.0);
+  EXPECT_LT(worst_apart, 1e-5);
+  EXPECT_LT(worst_half, 1.5 * tolerance);
+  EXPECT_LT(worst_single, 1.5 * tolerance);
+  EXPECT_LE(half.stats().assemblies, single.stats().assemblies + 2);
 }
 
 }  // namespace

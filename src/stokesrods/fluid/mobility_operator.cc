@@ -30,7 +30,7 @@ class DenseMobility final : public MobilityOperator {
  public:
   DenseMobility(const FluidParams& params, const MobilityOptions& options)
       : params_(params),
-        reuse_(options.reuse_tolerance),
+        reuse_(options.reuse_tolerance, options.reuse_tolerance >= kSinglePrecisionTolerance),
         single_products_(options.reuse_tolerance >= kSinglePrecisionTolerance) {}
 
   void Update(const std::vector<HydroRod>& rods) override {

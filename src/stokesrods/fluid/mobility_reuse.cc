@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "stokesrods/fluid/mobility_reuse_avx512.h"
+
 namespace stokesrods {
 namespace {
 
@@ -76,6 +78,9 @@ double TakeAssembly(Eigen::Index n, const double* exact, const TakePass& p, floa
 
 }  // namespace
 
+MobilityReuse::MobilityReuse(double tolerance, bool half_differences)
+    : tolerance_(tolerance), half_(half_differences && HasReuseHalfAvx512()) {}
+
 bool MobilityReuse::Update(const VecX& x, const Assemble& assemble, MatX* assembled,
                            Eigen::MatrixXf* extrapolated) {
   ++stats_.updates;
@@ -107,9 +112,15 @@ bool MobilityReuse::Update(const VecX& x, const Assemble& assemble, MatX* assemb
     ++since_;
     const double s = Position(x);
     extrapolated->resize(base_.rows(), base_.cols());
-    Extrapolate(base_.size(), base_.data(), static_cast<float>(s), slope_.data(),
-                static_cast<float>(s * (s + 1.0)), quadratic_ ? curve_.data() : nullptr,
-                extrapolated->data());
+    if (!half_current_) {
+      Extrapolate(base_.size(), base_.data(), static_cast<float>(s), slope_.data(),
+                  static_cast<float>(s * (s + 1.0)), quadratic_ ? curve_.data() : nullptr,
+                  extrapolated->data());
+      return false;
+    }
+    ExtrapolateHalfAvx512(base_.size(), base_.data(), static_cast<float>(s / slope_scale_),
+                          slope_half_.data(), static_cast<float>(s * (s + 1.0) / curve_scale_),
+                          quadratic_ ? curve_half_.data() : nullptr, extrapolated->data());
     return false;
   }
   if (!same_size) Forget();
@@ -157,6 +168,19 @@ void MobilityReuse::Take(const VecX& x, const MatX& assembled, bool measure) {
   double norm2 = 0.0;
   const double miss = std::sqrt(TakeAssembly(assembled.size(), assembled.data(), pass,
                                              base_.data(), slope_.data(), curve_.data(), &norm2));
+  // D₁, D₂ to half precision; slope_, curve_ then hold the values the half ones stand for, so
+  // that the next measurement reads what the extrapolation used (PRECISION).
+  half_current_ = false;
+  if (half_ && pass.new_slope) {
+    slope_half_.resize(static_cast<std::size_t>(slope_.size()));
+    slope_scale_ = RoundToHalfAvx512(slope_.size(), slope_.data(), slope_half_.data());
+    half_current_ = slope_scale_ > 0.0f;
+    if (quadratic && half_current_) {
+      curve_half_.resize(static_cast<std::size_t>(curve_.size()));
+      curve_scale_ = RoundToHalfAvx512(curve_.size(), curve_.data(), curve_half_.data());
+      half_current_ = curve_scale_ > 0.0f;
+    }
+  }
   if (measure) {
     ++stats_.measurements;
     const double error = miss / std::max(std::sqrt(norm2), 1e-300);
@@ -182,6 +206,7 @@ void MobilityReuse::Take(const VecX& x, const MatX& assembled, bool measure) {
 
 void MobilityReuse::Forget() {
   geometries_.clear();
+  half_current_ = false;
   quadratic_ = false;
   since_ = 0;
   interval_ = 1;

@@ -48,8 +48,15 @@
 // GemvRowsMixed). From a tolerance of kSinglePrecisionTolerance (1e-4) on, the dense operator's
 // products take the assembled 𝕄 rounded too (last_assembly_single(), the history's 𝕄_c): at a
 // large step, where 𝕄 is assembled at every step, each product then streams half the bytes.
+// With `half_differences` (that tolerance, and a CPU with AVX-512 BW: mobility_reuse_avx512.h)
+// D₁ and D₂ are also rounded to IEEE half precision, each scaled by a power of two, and the
+// single-precision D₁, D₂ the measurement reads are replaced by the values the half ones stand
+// for: the extrapolation streams 𝕄_c and half of D₁, D₂'s bytes, and e still measures exactly
+// what it uses (half's 2⁻¹¹ relative rounding of D₁, itself ~1e-2 of 𝕄 over an interval, is
+// ~1e-5 of 𝕄 at most: inside the default 1e-4).
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <optional>
 #include <vector>
@@ -88,7 +95,8 @@ class MobilityReuse {
   /// for even two steps.
   static constexpr int kMaxSkip = 8;
 
-  explicit MobilityReuse(double tolerance) : tolerance_(tolerance) {}
+  /// `half_differences`: D₁, D₂ in half precision where the CPU has the kernels (PRECISION).
+  explicit MobilityReuse(double tolerance, bool half_differences = false);
 
   /// 𝕄 at the node positions x (3M): assembled by `assemble` into `assembled` (returns true), or
   /// extrapolated into `extrapolated` (single precision; returns false). With tolerance 0 it
@@ -123,6 +131,10 @@ class MobilityReuse {
   Eigen::MatrixXf base_;   ///< 𝕄_c
   Eigen::MatrixXf slope_;  ///< D₁
   Eigen::MatrixXf curve_;  ///< D₂
+  bool half_ = false;      ///< D₁, D₂ rounded to half precision at each assembly (PRECISION)
+  bool half_current_ = false;  ///< slope_half_ (and curve_half_ if quadratic_) hold D₁, D₂
+  std::vector<std::uint16_t> slope_half_, curve_half_;  ///< σ₁ D₁, σ₂ D₂ in half precision
+  float slope_scale_ = 1.0f, curve_scale_ = 1.0f;       ///< σ₁, σ₂: powers of two
   std::optional<MobilityReuseHistory> restore_;  ///< to assemble again at the next Update
   MobilityReuseStats stats_;
 };
