@@ -95,6 +95,62 @@ TEST(BandedMatrix, SolvesLikeADenseLuIncludingIndefiniteMatrices) {
   EXPECT_LT((dense * x - b).norm(), 1e-10 * b.norm());
 }
 
+// A rod's Newton matrix at a time step is symmetric positive definite up to ~1e-6 of its
+// largest entry (the mass term M/h² over the stiffness, the frame transport's asymmetry): this
+// one, a positive definite band plus a 1e-6 asymmetry, is factorized without row interchanges,
+// and solves as LAPACK's pivoted LU and the dense LU do.
+TEST(BandedMatrix, FactorsAPositiveDefiniteMatrixWithoutPivoting) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (const int n : {1, 11, 259}) {
+    const int kd = 10;
+    BandedMatrix a(n, kd);
+    const int k = a.half_bandwidth();
+    for (int i = 0; i < n; ++i)
+      for (int j = std::max(0, i - k); j < i; ++j) a(i, j) = a(j, i) = u(rng);
+    for (int i = 0; i < n; ++i) a(i, i) = 2.0 * k + 1.0;  // diagonally dominant: definite
+    for (int i = 0; i < n; ++i)
+      for (int j = std::max(0, i - k); j <= std::min(n - 1, i + k); ++j) a(i, j) += 1e-6 * u(rng);
+    const MatX dense = a.ToDense();
+    const MatX b = MatX::Random(n, 5);
+    const MatX lapack = SolveWithLapack(dense, k, b);
+    ASSERT_TRUE(a.Factorize());
+    EXPECT_FALSE(a.pivoted()) << "n = " << n;
+    MatX x = b;
+    a.Solve(&x);  // several right-hand sides at once
+    VecX one = b.col(0);
+    a.Solve(&one);
+    EXPECT_LT((x - lapack).norm(), 1e-13 * lapack.norm()) << "n = " << n;
+    EXPECT_LT((one - lapack.col(0)).norm(), 1e-13 * lapack.col(0).norm()) << "n = " << n;
+    EXPECT_LT((dense * x - b).norm(), 1e-13 * b.norm()) << "n = " << n;
+  }
+}
+
+// Where elimination without interchanges meets a pivot that is not positive (an indefinite
+// matrix: here a negative diagonal entry in row 40 of an otherwise definite one) or its factors
+// grow (a positive definite symmetric part with a large skew part: [[1e-3, 1], [−1, 1]] grows
+// U(1, 1) to 1001), the matrix is factorized again from its entries with partial pivoting and
+// solves as the dense LU does.
+TEST(BandedMatrix, FallsBackToPivotingWhereThePivotsAreNotPositiveOrGrow) {
+  const int n = 60, kd = 3;
+  BandedMatrix indefinite(n, kd);
+  for (int i = 0; i < n; ++i) {
+    indefinite(i, i) = i == 40 ? -3.0 : 4.0;
+    if (i + 1 < n) indefinite(i, i + 1) = indefinite(i + 1, i) = -1.0;
+  }
+  BandedMatrix skew(2, 1);
+  skew(0, 0) = 1e-3, skew(0, 1) = 1.0, skew(1, 0) = -1.0, skew(1, 1) = 1.0;
+  for (BandedMatrix* a : {&indefinite, &skew}) {
+    const MatX dense = a->ToDense();
+    const VecX b = VecX::LinSpaced(a->size(), 1.0, 2.0);
+    ASSERT_TRUE(a->Factorize());
+    EXPECT_TRUE(a->pivoted()) << "size " << a->size();
+    VecX x = b;
+    a->Solve(&x);
+    EXPECT_LT((x - dense.lu().solve(b)).norm(), 1e-13 * x.norm()) << "size " << a->size();
+  }
+}
+
 TEST(BandedMatrix, FixDofMakesAnIdentityRowAndColumn) {
   BandedMatrix a(5, 1);
   for (int i = 0; i < 5; ++i) a(i, i) = 2.0;

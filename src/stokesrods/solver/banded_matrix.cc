@@ -106,13 +106,49 @@ inline __attribute__((always_inline)) bool FactorizeBand(int n, int kd_runtime, 
   return regular;
 }
 
+// LU without row interchanges, in the same storage (U in rows kd..2kd, L below; the fill rows
+// unused): false as soon as a pivot is not positive or an entry of U grows past twice the largest
+// entry of A (`largest`), where the caller factorizes again with pivoting. Positive pivots are
+// those of a matrix whose symmetric part is positive definite, as the rods' Newton matrices
+// are at time steps where the mass term M/h² dominates (asymmetric by ~1e-6 of their largest
+// entry, the frame transport's): elimination without pivoting is then stable, its growth
+// bounded by the asymmetry (Golub and Van Loan, "Unsymmetric positive definite linear systems",
+// 1979), and the growth is checked anyway. Half the work of the pivoted LU (no fill beyond kd,
+// no row swaps), and a U of bandwidth kd for the solves.
+template <int KD>
+inline __attribute__((always_inline)) bool FactorizeBandUnpivoted(int n, int kd_runtime,
+                                                                  double* ab, double largest) {
+  const int kd = KD > 0 ? KD : kd_runtime, kv = 2 * kd, ldab = 3 * kd + 1;
+  auto at = [&](int i, int j) -> double& {
+    return ab[(kv + i - j) + static_cast<std::ptrdiff_t>(j) * ldab];
+  };
+  const double limit = 2.0 * largest;
+  for (int j = 0; j < n; ++j) {
+    const int below = std::min(kd, n - 1 - j);
+    double* column = &at(j, j);  // column[i] = A(j + i, j)
+    if (!(column[0] > 0.0)) return false;
+    const double inverse_pivot = 1.0 / column[0];
+    for (int i = 1; i <= below; ++i) column[i] *= inverse_pivot;
+    for (int c = j + 1; c <= j + below; ++c) {  // the columns row j of U reaches
+      double* target = &at(j, c);  // target[i] = A(j + i, c)
+      if (!(std::abs(target[0]) <= limit)) return false;
+      if (target[0] != 0.0) Axpy<KD>(below, target[0], column + 1, target + 1);
+    }
+    if (!(column[0] <= limit)) return false;
+  }
+  return true;
+}
+
 // One right-hand side x (n) in place; `inverse_diagonal` holds 1/U(j, j) (a multiplication in
 // the chain of dependent updates instead of a division, which took half the solve's time).
-template <int KD>
-inline __attribute__((always_inline)) void SolveBand(int n, int kd_runtime, const double* ab,
-                                                     const int* pivots,
+// U's bandwidth is 2kd after pivoting, kd without (`KU` = 2 KD or KD; 0 with KD = 0: from
+// `pivoted` at run time).
+template <int KD, int KU>
+inline __attribute__((always_inline)) void SolveBand(int n, int kd_runtime, bool pivoted,
+                                                     const double* ab, const int* pivots,
                                                      const double* inverse_diagonal, double* x) {
   const int kd = KD > 0 ? KD : kd_runtime, kv = 2 * kd, ldab = 3 * kd + 1;
+  const int ku = KU > 0 ? KU : (pivoted ? kv : kd);
   // L: the row interchanges and multipliers in the order they were made.
   for (int j = 0; j + 1 < n; ++j) {
     const int p = pivots[j];
@@ -125,20 +161,20 @@ inline __attribute__((always_inline)) void SolveBand(int n, int kd_runtime, cons
   for (int j = n - 1; j >= 0; --j) {
     const double* column = ab + static_cast<std::ptrdiff_t>(j) * ldab;  // A(j − kv + r, j)
     x[j] *= inverse_diagonal[j];
-    const int top = std::max(0, j - kv);
-    constexpr int kUpper = KD > 0 ? 2 * KD : 0;
-    Axpy<kUpper>(j - top, x[j], column + kv + top - j, x + top);
+    const int top = std::max(0, j - ku);
+    Axpy<KU>(j - top, x[j], column + kv + top - j, x + top);
   }
 }
 
 // num_rhs right-hand sides stored by rows (x(i, k) at x[i · num_rhs + k]): each row operation one
 // long vector operation across them.
 template <int KD>
-inline __attribute__((always_inline)) void SolveBandRows(int n, int kd_runtime, const double* ab,
-                                                         const int* pivots,
+inline __attribute__((always_inline)) void SolveBandRows(int n, int kd_runtime, bool pivoted,
+                                                         const double* ab, const int* pivots,
                                                          const double* inverse_diagonal,
                                                          int num_rhs, double* x) {
   const int kd = KD > 0 ? KD : kd_runtime, kv = 2 * kd, ldab = 3 * kd + 1;
+  const int ku = pivoted ? kv : kd;
   auto row = [&](int i) { return x + static_cast<std::ptrdiff_t>(i) * num_rhs; };
   auto subtract = [num_rhs](double a, const double* from, double* to) {
 #pragma omp simd
@@ -154,7 +190,7 @@ inline __attribute__((always_inline)) void SolveBandRows(int n, int kd_runtime, 
   for (int j = n - 1; j >= 0; --j) {
     const double* column = ab + static_cast<std::ptrdiff_t>(j) * ldab;
     for (int k = 0; k < num_rhs; ++k) row(j)[k] *= inverse_diagonal[j];
-    for (int i = std::max(0, j - kv); i < j; ++i)
+    for (int i = std::max(0, j - ku); i < j; ++i)
       if (column[kv + i - j] != 0.0) subtract(column[kv + i - j], row(j), row(i));
   }
 }
@@ -169,19 +205,28 @@ bool Factorize(int n, int kd, double* ab, int* pivots) {
 }
 
 __attribute__((target_clones("avx512f", "avx2", "default")))
-void Solve(int n, int kd, const double* ab, const int* pivots, const double* inverse_diagonal,
-           double* x) {
-  if (kd == kRodHalfBandwidth)
-    return SolveBand<kRodHalfBandwidth>(n, kd, ab, pivots, inverse_diagonal, x);
-  SolveBand<0>(n, kd, ab, pivots, inverse_diagonal, x);
+bool FactorizeUnpivoted(int n, int kd, double* ab, double largest) {
+  return kd == kRodHalfBandwidth ? FactorizeBandUnpivoted<kRodHalfBandwidth>(n, kd, ab, largest)
+                                 : FactorizeBandUnpivoted<0>(n, kd, ab, largest);
 }
 
 __attribute__((target_clones("avx512f", "avx2", "default")))
-void SolveRows(int n, int kd, const double* ab, const int* pivots, const double* inverse_diagonal,
-               int num_rhs, double* x) {
+void Solve(int n, int kd, bool pivoted, const double* ab, const int* pivots,
+           const double* inverse_diagonal, double* x) {
+  if (kd != kRodHalfBandwidth) return SolveBand<0, 0>(n, kd, pivoted, ab, pivots, inverse_diagonal, x);
+  if (pivoted)
+    return SolveBand<kRodHalfBandwidth, 2 * kRodHalfBandwidth>(n, kd, pivoted, ab, pivots,
+                                                               inverse_diagonal, x);
+  SolveBand<kRodHalfBandwidth, kRodHalfBandwidth>(n, kd, pivoted, ab, pivots, inverse_diagonal, x);
+}
+
+__attribute__((target_clones("avx512f", "avx2", "default")))
+void SolveRows(int n, int kd, bool pivoted, const double* ab, const int* pivots,
+               const double* inverse_diagonal, int num_rhs, double* x) {
   if (kd == kRodHalfBandwidth)
-    return SolveBandRows<kRodHalfBandwidth>(n, kd, ab, pivots, inverse_diagonal, num_rhs, x);
-  SolveBandRows<0>(n, kd, ab, pivots, inverse_diagonal, num_rhs, x);
+    return SolveBandRows<kRodHalfBandwidth>(n, kd, pivoted, ab, pivots, inverse_diagonal, num_rhs,
+                                            x);
+  SolveBandRows<0>(n, kd, pivoted, ab, pivots, inverse_diagonal, num_rhs, x);
 }
 
 }  // namespace
@@ -194,7 +239,23 @@ void SolveRows(int n, int kd, const double* ab, const int* pivots, const double*
 bool BandedMatrix::Factorize() {
   SR_ASSERT(!factorized_, "matrix factorized twice");
   factorized_ = true;
-  const bool regular = stokesrods::Factorize(n_, kd_, ab_.data(), pivots_.data());
+  // Without pivoting where that is stable (FactorizeBandUnpivoted), else from the kept copy with
+  // partial pivoting.
+  double largest = 0.0;  // over the band's rows kd..3kd of the storage (zero outside A)
+  for (int j = 0; j < n_; ++j) {
+    const double* column = ab_.data() + kd_ + static_cast<std::ptrdiff_t>(j) * ldab_;
+#pragma omp simd reduction(max : largest)
+    for (int r = 0; r <= 2 * kd_; ++r) largest = std::max(largest, std::abs(column[r]));
+  }
+  original_ = ab_;
+  pivoted_ = !stokesrods::FactorizeUnpivoted(n_, kd_, ab_.data(), largest);
+  bool regular = true;
+  if (pivoted_) {
+    std::swap(ab_, original_);
+    regular = stokesrods::Factorize(n_, kd_, ab_.data(), pivots_.data());
+  } else {
+    for (int j = 0; j < n_; ++j) pivots_[static_cast<std::size_t>(j)] = j;
+  }
   inverse_diagonal_.resize(static_cast<std::size_t>(n_));
   for (int j = 0; j < n_; ++j) inverse_diagonal_[static_cast<std::size_t>(j)] = 1.0 / (*this)(j, j);
   return regular;
@@ -207,7 +268,7 @@ void BandedMatrix::Solve(double* b, int num_rhs) const {
     return;
   }
   for (int k = 0; k < num_rhs; ++k)
-    stokesrods::Solve(n_, kd_, ab_.data(), pivots_.data(), inverse_diagonal_.data(),
+    stokesrods::Solve(n_, kd_, pivoted_, ab_.data(), pivots_.data(), inverse_diagonal_.data(),
                       b + static_cast<std::ptrdiff_t>(k) * n_);
 }
 
@@ -215,7 +276,8 @@ void BandedMatrix::SolveManyRows(double* b, int num_rhs) const {
   using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   Eigen::Map<MatX> columns(b, n_, num_rhs);
   RowMajor x = columns;
-  SolveRows(n_, kd_, ab_.data(), pivots_.data(), inverse_diagonal_.data(), num_rhs, x.data());
+  SolveRows(n_, kd_, pivoted_, ab_.data(), pivots_.data(), inverse_diagonal_.data(), num_rhs,
+            x.data());
   columns = x;
 }
 

@@ -2,8 +2,11 @@
 //
 // The Jacobian of one discrete rod couples only DOFs within one bending stencil
 // (x_{i−1}, θ^{i−1}, x_i, θ^i, x_{i+1}: 11 consecutive entries of q), so its half bandwidth is 10
-// and a solve costs O(N) for N nodes. Partial pivoting keeps the solve correct when the
-// matrix is indefinite (compressed or buckling rods in a static solve).
+// and a solve costs O(N) for N nodes. The LU is taken without row interchanges where that is
+// stable (positive pivots, no growth: the symmetric part positive definite, as the rods' Newton
+// matrices are at a time step's mass term), at half the cost; else with partial pivoting, which
+// keeps the solve correct when the matrix is indefinite (compressed or buckling rods in a static
+// solve).
 #pragma once
 
 #include <vector>
@@ -46,6 +49,8 @@ class BandedMatrix {
   /// LU-factorizes in place; returns false if the matrix is singular. After this the
   /// entries are the factors: only Solve may be used until the next SetZero.
   bool Factorize();
+  /// Whether the last Factorize interchanged rows (partial pivoting) or needed none.
+  bool pivoted() const { return pivoted_; }
   /// Solves A x = b in place for one or more right-hand sides (columns of b).
   void Solve(double* b, int num_rhs) const;
   void Solve(VecX* b) const { Solve(b->data(), 1); }
@@ -64,7 +69,9 @@ class BandedMatrix {
   std::vector<double> ab_;
   std::vector<int> pivots_;
   std::vector<double> inverse_diagonal_;  // 1/U(j, j) after Factorize
+  std::vector<double> original_;  // A while Factorize tries it without pivoting
   bool factorized_ = false;
+  bool pivoted_ = true;  // the factors hold row interchanges (U of bandwidth 2kd)
 };
 
 }  // namespace stokesrods
