@@ -80,6 +80,36 @@ TEST(Gmres, AbsoluteToleranceInTheLargestComponentStopsSoonerAndHoldsIt) {
   EXPECT_GT((b - a * x_max).norm(), tolerance);
 }
 
+// G x of the solution from the products' sides (a 120 × 200 G applied with A in each product):
+// the same as G applied to the returned x, to rounding, across restarts and from a non-zero
+// initial guess, and with one product per iteration (G never applied to x itself).
+TEST(Gmres, GivesTheSideMapOfItsSolutionFromTheProducts) {
+  std::mt19937 rng(5);
+  const int n = 200;
+  const MatX a = SpreadMatrix(n, &rng);
+  const MatX g = MatX::Random(120, n);
+  const VecX b = RandomVector(n, &rng);
+  int products = 0;
+  const LinearOperatorWithSide with_side = [&](const VecX& x, VecX* y, VecX* side) {
+    *y = a * x;
+    if (side) *side = g * x;
+    ++products;
+  };
+  for (const int restart : {50, 4}) {
+    for (const bool guess : {false, true}) {
+      VecX x = guess ? VecX(RandomVector(n, &rng)) : VecX(), ax, gx;
+      products = 0;
+      const GmresReport report =
+          SolveGmres(with_side, {}, b, {.tolerance = 1e-10, .restart = restart}, &x, &ax, &gx);
+      ASSERT_TRUE(report.converged);
+      EXPECT_EQ(products, report.iterations + (guess ? 1 : 0));
+      ASSERT_EQ(gx.size(), 120);
+      EXPECT_LT((gx - g * x).norm(), 1e-12 * (g * x).norm())
+          << "restart " << restart << ", guess " << guess;
+    }
+  }
+}
+
 TEST(Gmres, ZeroRightHandSideGivesZero) {
   VecX x = VecX::Ones(3);
   const MatX a = MatX::Identity(3, 3);

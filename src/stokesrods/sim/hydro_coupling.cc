@@ -285,14 +285,19 @@ HydroSolveReport HydroCoupling::SolveNewtonSystem(const Model& model,
       if (k % 4 != 3) sy(3 * rod.node_offset + 3 * (k / 4) + k % 4) = 0.0;
   if (borders_) AddClampBorderRhs(model, h, *borders_, *dq, &sy);
   const VecX b = -(h * r_u + sy);
-  VecX cdf;  // C δf
+  VecX cdf;   // C δf
+  VecX x_df;  // X δf = B⁻¹ Sᵀ δf, when the Krylov solve gives it (else solved for below)
   if (!krylov_) {
     SR_ASSERT(!mobility_changed_, "the direct solve needs the capacitance of the current 𝕄");
     *df = capacitance_lu_.solve(b);
     ApplyCapacitance(model, h, *df, &cdf);
     report.relative_residual = (b - cdf).norm() / std::max(b.norm(), 1e-300);
   } else {
-    const LinearOperator apply = [&](const VecX& x, VecX* y) { ApplyCapacitance(model, h, x, y); };
+    // Each product solves for X v = B⁻¹ Sᵀ v (ApplyCapacitance): GMRES combines them into X δf.
+    const LinearOperatorWithSide apply = [&](const VecX& x, VecX* y, VecX* xv) {
+      ApplyCapacitance(model, h, x, y);
+      if (xv) *xv = scratch_dofs_;
+    };
     const LinearOperator precondition = [&](const VecX& x, VecX* y) { Precondition(x, y); };
     df->setZero(b.size());
     // r_u after the step is −(b − C δf)/h, and the Newton test reads its largest component:
@@ -302,7 +307,7 @@ HydroSolveReport HydroCoupling::SolveNewtonSystem(const Model& model,
                                      {.tolerance = model.hydro.krylov_tolerance,
                                       .absolute_tolerance = h * velocity_tolerance,
                                       .absolute_in_max_norm = true},
-                                     df, &cdf);
+                                     df, &cdf, &x_df);
     report.ok = g.converged;
     report.krylov_iterations = g.iterations;
     report.relative_residual = g.relative_residual;
@@ -313,8 +318,8 @@ HydroSolveReport HydroCoupling::SolveNewtonSystem(const Model& model,
     wants_refresh_ = g.iterations > 2 * iterations_after_refresh_ + 2;
   }
   // δq = y + X δf = y + B⁻¹ Sᵀ δf;  du = S δq/h + 𝕄 δf = (S y + C δf)/h.
-  SolveBanded(model, *df, nullptr, &scratch_dofs_);
-  *dq += scratch_dofs_;
+  if (x_df.size() == 0) SolveBanded(model, *df, nullptr, &x_df);  // direct, or δf = 0
+  *dq += x_df;
   if (borders_) AddClampMotion(model, h, *borders_, *df, dq);
   *du = (sy + cdf) / h;
   return report;

@@ -8,9 +8,17 @@ namespace stokesrods {
 
 GmresReport SolveGmres(const LinearOperator& a, const LinearOperator& preconditioner,
                        const VecX& b, const GmresOptions& options, VecX* x, VecX* ax) {
+  const LinearOperatorWithSide product = [&](const VecX& in, VecX* out, VecX*) { a(in, out); };
+  return SolveGmres(product, preconditioner, b, options, x, ax, nullptr);
+}
+
+GmresReport SolveGmres(const LinearOperatorWithSide& a, const LinearOperator& preconditioner,
+                       const VecX& b, const GmresOptions& options, VecX* x, VecX* ax,
+                       VecX* side_of_x) {
   const Eigen::Index n = b.size();
   if (x->size() != n) x->setZero(n);
   GmresReport report;
+  if (side_of_x) side_of_x->resize(0);
   const double b_norm = b.norm();
   if (b_norm == 0.0) {
     x->setZero();
@@ -45,8 +53,10 @@ GmresReport SolveGmres(const LinearOperator& a, const LinearOperator& preconditi
     return residual.lpNorm<Eigen::Infinity>() <= margin * options.absolute_tolerance;
   };
 
+  MatX sides;                   // G z_j, as the products give them (side_of_x only)
+  VecX side;
   VecX product = VecX::Zero(n);  // A x
-  if (!x->isZero(0.0)) a(*x, &product);
+  if (!x->isZero(0.0)) a(*x, &product, side_of_x);
   r = b - product;
   double r_norm = r.norm();
   const double sqrt_n = std::sqrt(static_cast<double>(n));
@@ -68,8 +78,12 @@ GmresReport SolveGmres(const LinearOperator& a, const LinearOperator& preconditi
       VecX zk(n);
       apply_p(v.col(k), &zk);
       z.col(k) = zk;
-      a(zk, &w);
+      a(zk, &w, side_of_x ? &side : nullptr);
       ++report.iterations;
+      if (side_of_x) {
+        if (sides.cols() != m) sides.resize(side.size(), m);
+        sides.col(k) = side;
+      }
       for (int i = 0; i <= k; ++i) {  // modified Gram–Schmidt
         hess(i, k) = v.col(i).dot(w);
         w -= hess(i, k) * v.col(i);
@@ -112,6 +126,10 @@ GmresReport SolveGmres(const LinearOperator& a, const LinearOperator& preconditi
     // Back substitution for y (k × k upper triangular), x += Z y.
     const VecX y = least_squares(k);
     *x += z.leftCols(k) * y;
+    if (side_of_x) {
+      if (side_of_x->size() == 0) side_of_x->setZero(sides.rows());
+      *side_of_x += sides.leftCols(k) * y;
+    }
     // A x from the Arnoldi relation, A (x + Z y) = A x + V_{k+1} H̄_k y: no extra product, and the
     // residual b − A x is formed explicitly (its norm equals the least-squares estimate up to the
     // basis' loss of orthogonality, which a restart then corrects).

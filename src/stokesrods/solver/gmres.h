@@ -39,4 +39,17 @@ struct GmresReport {
 GmresReport SolveGmres(const LinearOperator& a, const LinearOperator& preconditioner,
                        const VecX& b, const GmresOptions& options, VecX* x, VecX* ax = nullptr);
 
+/// y = A x and, when `side` is given, side = G x for a second linear map G that the product
+/// computes on its way (HydroCoupling: B⁻¹ Sᵀ x, solved for by every product with its
+/// capacitance C = h 𝕄 + S B⁻¹ Sᵀ).
+using LinearOperatorWithSide = std::function<void(const VecX& x, VecX* y, VecX* side)>;
+
+/// The same solve, also giving `side_of_x` = G x of the returned x: the combination of the
+/// products' sides that makes x, so G is never applied to x itself (one application of G less
+/// per solve; exact up to rounding). Left empty where no product was taken (x then is the zero
+/// initial guess, and G x = 0).
+GmresReport SolveGmres(const LinearOperatorWithSide& a, const LinearOperator& preconditioner,
+                       const VecX& b, const GmresOptions& options, VecX* x, VecX* ax,
+                       VecX* side_of_x);
+
 }  // namespace stokesrods
