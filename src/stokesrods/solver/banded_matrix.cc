@@ -241,14 +241,20 @@ bool BandedMatrix::Factorize() {
   factorized_ = true;
   // Without pivoting where that is stable (FactorizeBandUnpivoted), else from the kept copy with
   // partial pivoting.
-  double largest = 0.0;  // over the band's rows kd..3kd of the storage (zero outside A)
-  for (int j = 0; j < n_; ++j) {
-    const double* column = ab_.data() + kd_ + static_cast<std::ptrdiff_t>(j) * ldab_;
-#pragma omp simd reduction(max : largest)
-    for (int r = 0; r <= 2 * kd_; ++r) largest = std::max(largest, std::abs(column[r]));
-  }
+  // The largest |entry| of A: the storage holds zeros outside it (Resize, SetZero), scanned in
+  // four interleaved runs (one chain of max would cost its latency per entry).
+  double largest[4] = {0.0, 0.0, 0.0, 0.0};
+  const std::size_t stored = ab_.size();
+  for (std::size_t k = 0; k + 4 <= stored; k += 4)
+    for (int lane = 0; lane < 4; ++lane) {
+      const double v = std::abs(ab_[k + static_cast<std::size_t>(lane)]);
+      largest[lane] = v > largest[lane] ? v : largest[lane];
+    }
+  for (std::size_t k = stored / 4 * 4; k < stored; ++k)
+    largest[0] = std::max(largest[0], std::abs(ab_[k]));
   original_ = ab_;
-  pivoted_ = !stokesrods::FactorizeUnpivoted(n_, kd_, ab_.data(), largest);
+  pivoted_ = !stokesrods::FactorizeUnpivoted(
+      n_, kd_, ab_.data(), std::max(std::max(largest[0], largest[1]), std::max(largest[2], largest[3])));
   bool regular = true;
   if (pivoted_) {
     std::swap(ab_, original_);
