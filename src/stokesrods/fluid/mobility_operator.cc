@@ -167,13 +167,20 @@ class MatrixFreeRssMobility final : public MobilityOperator {
              .direct_below_pairs = static_cast<std::int64_t>(options.direct_sum_below),
              .choose_by_cost = options.fast_sum_by_cost})),
         far_rule_by_distance_(options.far_rule_by_distance),
-        single_far_(options.fast_sum_tolerance >= kSinglePrecisionTolerance) {
+        single_far_(options.fast_sum_tolerance >= kSinglePrecisionTolerance),
+        reuse_near_(single_far_ && options.reuse_tolerance > 0.0),
+        near_reuse_(reuse_near_ ? options.reuse_tolerance : 0.0,
+                    options.reuse_tolerance >= kSinglePrecisionTolerance) {
     SR_ASSERT(!params.wall, "the matrix-free RSS is the free-space operator: a wall's images wrap "
                             "it (MakeMobilityWithWallImages, fluid/wall_sources.h)");
   }
 
   void Update(const std::vector<HydroRod>& rods) override;
-  void ForgetHistory() override { choose_split_ = true; }
+  void ForgetHistory() override {
+    choose_split_ = true;
+    near_reuse_.Forget();
+  }
+  MobilityReuseStats reuse_stats() const override { return near_reuse_.stats(); }
   void Apply(const VecX& force, VecX* velocity) const override;
   MatX SelfBlock(int rod) const override {
     MatX block;
@@ -193,8 +200,16 @@ class MatrixFreeRssMobility final : public MobilityOperator {
     int rod = 0;
   };
 
-  // The far rule's points, the far sum and the near blocks at the nodes, for split_.
-  void BuildSplit();
+  // The far rule's points, the far sum and the near blocks at the nodes, for split_; `reuse`:
+  // the near blocks through near_reuse_ (else computed, for ChooseSplitByCost's trials).
+  void BuildSplit(bool reuse = true);
+  // near_ at the nodes: computed, or extrapolated by near_reuse_ while the pattern holds.
+  void UpdateNearBlocks();
+  // Which nodes each target's near blocks take (NearBlocks' start and source, no values).
+  void FindNearPattern(const Matrix3X& targets, NearBlocks* pattern) const;
+  // The near segments of each target, to `visit(t, near segments, scratch)` (in parallel).
+  template <typename Visit>
+  void ForEachTargetsNearSegments(const Matrix3X& targets, const Visit& visit) const;
   // Keeps the cheaper of split_ and the rule with one more point (ChooseNearFarSplit).
   void ChooseSplitByCost();
   // The near blocks at p (node, block) of its near segments (NearSegmentSearch::SegmentsNear).
@@ -229,6 +244,12 @@ class MatrixFreeRssMobility final : public MobilityOperator {
   Matrix3X gauss_points_;           // 3 × (segments × points)
   VecX gauss_eps_;
   NearBlocks near_;                 // the near corrections at the nodes
+  // Their values (9 × blocks) reused across Updates while the pattern holds (fluid/
+  // mobility_reuse.h, at the dense 𝕄's reuse tolerance, where the far sum is in single
+  // precision); forgotten at restart points and when the split changes, so a resumed run
+  // extrapolates as the uninterrupted one.
+  bool reuse_near_;
+  MobilityReuse near_reuse_;
   // FindNearBlocks' blocks per target before they are packed (kept: their capacity is reused).
   mutable std::vector<std::vector<std::pair<int, Mat3>>> per_target_;
   mutable Matrix3X strengths_, far_velocity_, density_;
@@ -269,7 +290,7 @@ void MatrixFreeRssMobility::ChooseSplitByCost() {
   for (const int extra : {1, 0}) {  // the fewest points last: most often kept, then not rebuilt
     split_ = {fewest_points_.gauss_points + extra,
               NearRadius(fewest_points_.gauss_points + extra, accuracy_)};
-    BuildSplit();
+    BuildSplit(false);
     const MobilityCostCounts c = cost_counts();
     const auto blocks = static_cast<double>(c.near_blocks);
     const double cost = kBuildPerBlock * blocks +
@@ -278,11 +299,13 @@ void MatrixFreeRssMobility::ChooseSplitByCost() {
   }
   if (best.gauss_points != split_.gauss_points) {
     split_ = best;
-    BuildSplit();
+    BuildSplit(false);
   }
+  near_reuse_.Forget();
+  if (reuse_near_) UpdateNearBlocks();  // the chosen split's blocks start the reuse's history
 }
 
-void MatrixFreeRssMobility::BuildSplit() {
+void MatrixFreeRssMobility::BuildSplit(bool reuse) {
   const double* alpha = nullptr;
   const double* weight = nullptr;
   GaussLegendreRule01(split_.gauss_points, &alpha, &weight);
@@ -297,7 +320,10 @@ void MatrixFreeRssMobility::BuildSplit() {
     }
   }
   far_->Build(gauss_points_, gauss_eps_, nodes_);
-  FindNearBlocks(nodes_, &near_);
+  if (reuse)
+    UpdateNearBlocks();
+  else
+    FindNearBlocks(nodes_, &near_);
   const StokesletSumStats far = far_->Stats();
   use_rule_sum_ = far_rule_by_distance_ && g > 2 && far.far_pairs == 0;
   if (use_rule_sum_) {
@@ -320,19 +346,15 @@ void MatrixFreeRssMobility::SegmentLists(std::vector<int>* first_node, VecX* eps
   for (int r = 0; r <= num_rods(); ++r) rod_first_segment->push_back(node_offset(r) - r);
 }
 
-void MatrixFreeRssMobility::FindNearBlocks(const Matrix3X& targets, NearBlocks* out) const {
+template <typename Visit>
+void MatrixFreeRssMobility::ForEachTargetsNearSegments(const Matrix3X& targets,
+                                                       const Visit& visit) const {
   std::vector<int> first_node, rod_first_segment;
   VecX eps;
   SegmentLists(&first_node, &eps, &rod_first_segment);
   NearSegmentSearch search;
   search.Build(nodes_, first_node, eps, rod_first_segment, split_.near_delta);
-  std::vector<RssRowKernel> kernels;
-  for (int r = 0; r < num_rods(); ++r)
-    kernels.emplace_back(*rods_[static_cast<size_t>(r)].x,
-                         params_.regularization * rods_[static_cast<size_t>(r)].radius,
-                         accuracy_, split_.gauss_points);
   const int m = static_cast<int>(targets.cols());
-  per_target_.resize(static_cast<size_t>(m));
   // Targets by blocks of kTargetBlock consecutive columns (a rod's nodes: close together): the
   // chunks near a block's bounding box are found once for the block, so that each target tests
   // only those (a test per target and rod was O(targets × rods): 5 % of the step at 100 helices).
@@ -351,11 +373,71 @@ void MatrixFreeRssMobility::FindNearBlocks(const Matrix3X& targets, NearBlocks* 
       search.ChunksNear(block_box, &block_chunks);
       for (int t = t_begin; t < t_end; ++t) {
         search.SegmentsNear(targets.col(t), block_chunks, &flags, &near);
-        NearPairBlocks(targets.col(t), near, kernels, &scratch, &per_target_[static_cast<size_t>(t)]);
+        visit(t, near, &scratch);
       }
     }
   }
+}
+
+void MatrixFreeRssMobility::FindNearBlocks(const Matrix3X& targets, NearBlocks* out) const {
+  std::vector<RssRowKernel> kernels;
+  for (int r = 0; r < num_rods(); ++r)
+    kernels.emplace_back(*rods_[static_cast<size_t>(r)].x,
+                         params_.regularization * rods_[static_cast<size_t>(r)].radius,
+                         accuracy_, split_.gauss_points);
+  per_target_.resize(static_cast<size_t>(targets.cols()));
+  ForEachTargetsNearSegments(targets, [&](int t, const std::vector<int>& near,
+                                          NearRowScratch* scratch) {
+    NearPairBlocks(targets.col(t), near, kernels, scratch, &per_target_[static_cast<size_t>(t)]);
+  });
   PackNearBlocks(per_target_, single_far_, out);
+}
+
+void MatrixFreeRssMobility::FindNearPattern(const Matrix3X& targets, NearBlocks* pattern) const {
+  const int m = static_cast<int>(targets.cols());
+  std::vector<std::vector<int>> nodes(static_cast<size_t>(m));
+  ForEachTargetsNearSegments(targets, [&](int t, const std::vector<int>& near, NearRowScratch*) {
+    // NearPairBlocks' nodes: node k of a rod takes a block when segment k or k − 1 is near.
+    std::vector<int>& out = nodes[static_cast<size_t>(t)];
+    out.clear();
+    for (const int segment : near) {
+      const int node = segments_[static_cast<size_t>(segment)].a;
+      if (out.empty() || out.back() != node) out.push_back(node);
+      out.push_back(node + 1);
+    }
+  });
+  pattern->start.assign(1, 0);
+  pattern->source.clear();
+  for (const std::vector<int>& list : nodes) {
+    pattern->source.insert(pattern->source.end(), list.begin(), list.end());
+    pattern->start.push_back(static_cast<int>(pattern->source.size()));
+  }
+}
+
+void MatrixFreeRssMobility::UpdateNearBlocks() {
+  if (!reuse_near_) return FindNearBlocks(nodes_, &near_);
+  NearBlocks pattern;
+  FindNearPattern(nodes_, &pattern);
+  if (pattern.start != near_.start || pattern.source != near_.source) near_reuse_.Forget();
+  const auto count = static_cast<Eigen::Index>(pattern.size());
+  const VecX x = nodes_.reshaped();
+  MatX exact;
+  Eigen::MatrixXf extrapolated;
+  const auto assemble = [&](const VecX& /*at: the current nodes, no history is restored*/,
+                            MatX* values) {
+    FindNearBlocks(nodes_, &near_);
+    SR_ASSERT(near_.source == pattern.source, "the near pattern changed within an Update");
+    // (in single precision, as the far sum: reuse_near_ only there)
+    *values = Eigen::Map<const Eigen::MatrixXf>(near_.block_single.front().data(), 9, count)
+                  .cast<double>();
+  };
+  if (count == 0 || near_reuse_.Update(x, assemble, &exact, &extrapolated)) return;
+  near_.start = std::move(pattern.start);
+  near_.source = std::move(pattern.source);
+  near_.single = true;
+  near_.block.clear();
+  near_.block_single.resize(static_cast<size_t>(count));
+  Eigen::Map<Eigen::MatrixXf>(near_.block_single.front().data(), 9, count) = extrapolated;
 }
 
 void MatrixFreeRssMobility::NearPairBlocks(const Vec3& p, const std::vector<int>& near,

@@ -35,7 +35,7 @@ const std::map<std::string, std::string>& Meanings() {
       {"fluid.mobility", "\"auto\" (dense up to 500 nodes, and with bodies), \"dense\" or \"matrix_free\" (RSS only; takes bodies and a wall)"},
       {"fluid.far_field_tolerance", "dense Krylov path: relative error of one far segment–node interaction; matrix-free: the far field is accurate to the larger of this and fast_sum_tolerance"},
       {"fluid.fast_sum_tolerance", "matrix-free: error bound of the far-field sum at every size (sets the FMM's expansion order, single precision from 1e-4, with bodies at most 1e-5 in double; the FMM runs only where it pays, from about 20 flagella)"},
-      {"fluid.mobility_reuse_tolerance", "dense RSS mobility: 𝕄 is extrapolated from its last two assemblies between steps while its measured relative error (Frobenius) stays below this; 0 assembles it at every step; summary.json mobility_reuse"},
+      {"fluid.mobility_reuse_tolerance", "RSS: the dense 𝕄, or the matrix-free operator's near corrections (where its far sum is in single precision, fast_sum_tolerance ≥ 1e-4), are extrapolated from their last assemblies between steps while their measured relative error (Frobenius) stays below this (the near corrections while their pattern of near pairs holds); 0 assembles them at every step; summary.json mobility_reuse"},
       {"fluid.solver", "implicit coupling: \"krylov\" (GMRES) or \"direct\" (dense LU; dense mobility only)"},
       {"fluid.krylov_tolerance", "GMRES relative residual"},
       {"contact.enabled", "rod–rod and self contact (paper section 2.3), of rods with the wall and the bodies, and of the bodies with each other and the wall"},
