@@ -320,7 +320,8 @@ int RunCase(const Options& options, const CaseSpec& spec, nlohmann::ordered_json
   j["newton_per_step"] = Number(ms.empty() ? std::nan("") : static_cast<double>(newton) / n);
   j["krylov_per_step"] = Number(ms.empty() ? std::nan("") : static_cast<double>(krylov) / n);
   j["wall_s_per_sim_s"] = Number(mean * 1e-3 / h);
-  if (ws.nonlocal_fluid && ws.hydro.mobility().matrix() != nullptr) {  // the dense 𝕄's reuse
+  // The reuse of the dense 𝕄, or of the matrix-free operator's near corrections.
+  if (ws.nonlocal_fluid && ws.hydro.mobility().reuse_stats().updates > 0) {
     const MobilityReuseStats reuse = ws.hydro.mobility().reuse_stats();
     j["assemblies_per_step"] =
         Number(ms.empty() ? std::nan("") : static_cast<double>(reuse.assemblies - reuse_start.assemblies) / n);
