@@ -431,7 +431,12 @@ void MatrixFreeRssMobility::UpdateNearBlocks() {
     *values = Eigen::Map<const Eigen::MatrixXf>(near_.block_single.front().data(), 9, count)
                   .cast<double>();
   };
-  if (count == 0 || near_reuse_.Update(x, assemble, &exact, &extrapolated)) return;
+  if (count == 0) {  // no near pairs at all: nothing to compute or reuse
+    near_ = std::move(pattern);
+    near_.single = true;
+    return;
+  }
+  if (near_reuse_.Update(x, assemble, &exact, &extrapolated)) return;  // near_ computed
   near_.start = std::move(pattern.start);
   near_.source = std::move(pattern.source);
   near_.single = true;
