@@ -163,7 +163,7 @@ __attribute__((target("avx512f"))) void ExtrapolateSingle(Eigen::Index n, const 
   for (Eigen::Index i = 0; i < n; ++i) out[i] = base[i] + s * slope[i] + c * curve[i];
 }
 void BM_ReuseExtrapolate(benchmark::State& st, bool half) {
-  if (!HasReuseHalfAvx512()) return st.SkipWithError("no AVX-512 BW on this CPU");
+  if (!HasLuSolveHalfAvx512()) return st.SkipWithError("no AVX-512 BW on this CPU");
   const int n = 390;
   const Eigen::MatrixXf base = Eigen::MatrixXf::Random(n, n);
   Eigen::MatrixXf slope = 1e-2f * Eigen::MatrixXf::Random(n, n);

@@ -314,7 +314,7 @@ float DecodeHalf(std::uint16_t h) {
 // half precision's rounding (2⁻¹¹ relative in its normal range, 2⁻²⁵ of the scale below it); the
 // scale is the power of two that puts the largest entry in [2¹⁴, 2¹⁵).
 TEST(MobilityReuseHalf, RoundsToWhatTheHalfValuesStandFor) {
-  if (!HasReuseHalfAvx512()) GTEST_SKIP() << "no AVX-512 BW on this CPU";
+  if (!HasLuSolveHalfAvx512()) GTEST_SKIP() << "no AVX-512 BW on this CPU";
   std::mt19937 random(7);
   std::uniform_real_distribution<float> decade(-7.0f, 2.0f), unit(-1.0f, 1.0f);
   for (const int n : {1, 15, 16, 17, 1000}) {
@@ -354,7 +354,7 @@ TEST(MobilityReuseHalf, RoundsToWhatTheHalfValuesStandFor) {
 // decoded values, to single precision's rounding of the sum (with and without the curve; n with
 // masked tails).
 TEST(MobilityReuseHalf, ExtrapolatesTheDecodedDifferences) {
-  if (!HasReuseHalfAvx512()) GTEST_SKIP() << "no AVX-512 BW on this CPU";
+  if (!HasLuSolveHalfAvx512()) GTEST_SKIP() << "no AVX-512 BW on this CPU";
   std::mt19937 random(11);
   std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
   for (const int n : {5, 16, 390 * 390}) {
@@ -386,7 +386,7 @@ TEST(MobilityReuseHalf, ExtrapolatesTheDecodedDifferences) {
 // the interval's change of 𝕄, ~1e-2: ≤ 1e-5 of 𝕄), both stay within the tolerance, and the
 // half one assembles about as often (its error measured on the values it uses).
 TEST(MobilityReuseHalf, ExtrapolatesAsTheSinglePrecisionHistoryWithinTheTolerance) {
-  if (!HasReuseHalfAvx512()) GTEST_SKIP() << "no AVX-512 BW on this CPU";
+  if (!HasLuSolveHalfAvx512()) GTEST_SKIP() << "no AVX-512 BW on this CPU";
   const double tolerance = 1e-4;
   FluidParams params;
   MobilityReuse half(tolerance, true), single(tolerance, false);

@@ -252,6 +252,7 @@ class MatrixFreeRssMobility final : public MobilityOperator {
   MobilityReuse near_reuse_;
   // FindNearBlocks' blocks per target before they are packed (kept: their capacity is reused).
   mutable std::vector<std::vector<std::pair<int, Mat3>>> per_target_;
+  mutable std::vector<std::vector<int>> pattern_nodes_;  // FindNearPattern's, likewise
   mutable Matrix3X strengths_, far_velocity_, density_;
 };
 
@@ -394,8 +395,8 @@ void MatrixFreeRssMobility::FindNearBlocks(const Matrix3X& targets, NearBlocks* 
 }
 
 void MatrixFreeRssMobility::FindNearPattern(const Matrix3X& targets, NearBlocks* pattern) const {
-  const int m = static_cast<int>(targets.cols());
-  std::vector<std::vector<int>> nodes(static_cast<size_t>(m));
+  std::vector<std::vector<int>>& nodes = pattern_nodes_;  // kept: their capacity is reused
+  nodes.resize(static_cast<size_t>(targets.cols()));
   ForEachTargetsNearSegments(targets, [&](int t, const std::vector<int>& near, NearRowScratch*) {
     // NearPairBlocks' nodes: node k of a rod takes a block when segment k or k − 1 is near.
     std::vector<int>& out = nodes[static_cast<size_t>(t)];

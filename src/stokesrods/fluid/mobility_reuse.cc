@@ -82,7 +82,7 @@ double TakeAssembly(Eigen::Index n, const double* exact, const TakePass& p, floa
 }  // namespace
 
 MobilityReuse::MobilityReuse(double tolerance, bool half_differences)
-    : tolerance_(tolerance), half_(half_differences && HasReuseHalfAvx512()) {}
+    : tolerance_(tolerance), half_(half_differences && HasLuSolveHalfAvx512()) {}
 
 bool MobilityReuse::Update(const VecX& x, const Assemble& assemble, MatX* assembled,
                            Eigen::MatrixXf* extrapolated) {

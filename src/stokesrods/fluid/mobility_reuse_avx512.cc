@@ -71,18 +71,12 @@ SR_HALF void ExtrapolateHalfAvx512(Eigen::Index n, const float* base, float a,
 #pragma GCC diagnostic pop
 #endif
 
-bool HasReuseHalfAvx512() {
-  static const bool has = __builtin_cpu_supports("avx512f") &&
-                          __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl");
-  return has;
-}
 #undef SR_HALF
 
 #else
 float RoundToHalfAvx512(Eigen::Index, float*, std::uint16_t*) { return 0.0f; }
 void ExtrapolateHalfAvx512(Eigen::Index, const float*, float, const std::uint16_t*, float,
                            const std::uint16_t*, float*) {}
-bool HasReuseHalfAvx512() { return false; }
 #endif
 
 }  // namespace stokesrods
