@@ -18,6 +18,9 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
+
+#include <omp.h>
 
 #include "common/model_from_toml.h"
 #include "stokesrods/sim/integrator.h"
@@ -218,14 +221,14 @@ base = [0.03, 0.0, 0.0]
           "LSBT, dense + GMRES");
 }
 
-TEST(FastPath, TenFlagellaOnARing) {
-  // Ten helices (25 nodes each) on a ring with neighbouring bases 3R apart, 20 steps.
+// Ten helices (25 nodes each) on a ring with neighbouring bases 3R apart, with `fluid`'s keys.
+std::string TenFlagella(const std::string& fluid) {
   std::string toml = R"(
 [run]
 duration = 1.0
 [fluid]
 model = "rss"
-FLUID
+)" + fluid + R"(
 [contact]
 enabled = true
 )";
@@ -234,11 +237,12 @@ enabled = true
     toml += "[[rods]]\nnodes = 25\nomega_bar = 320\nbase = [" +
             std::to_string(ring * std::cos(2 * kPi * k / 10)) + ", " +
             std::to_string(ring * std::sin(2 * kPi * k / 10)) + ", 0.0]\n";
-  auto with = [&](const std::string& fluid) {
-    std::string t = toml;
-    t.replace(t.find("FLUID"), 5, fluid);
-    return t;
-  };
+  return toml;
+}
+
+TEST(FastPath, TenFlagellaOnARing) {
+  // 20 steps.
+  const auto with = TenFlagella;
   const std::string dense = "mobility = \"dense\"\nmobility_reuse_tolerance = 0\n";
   const Series ref = RunSeries(with(dense + "solver = \"direct\""), 20, 5);
   Compare(ref, RunSeries(with(dense + "solver = \"krylov\""), 20, 5), 0.01,
@@ -258,6 +262,40 @@ enabled = true
   first.q.resize(2);
   first.clamp_force.resize(2);
   Compare(first, RunSeries(fmm, 10, 5), 0.01, "10 flagella, matrix-free + FMM (p = 6) + GMRES", 2e-4);
+}
+
+// The test suite runs one thread per test (CMakePresets.json's test presets: two tests at a time
+// on two cores; two threads each made the suite 4× slower). The parallel loops (the rods' elastic
+// forces, the products by blocks of rows, the near blocks, the Stokeslet sums, the extrapolation,
+// the LU solves) are checked here instead: two threads step as one, bit for bit (each loop
+// writes its own outputs, and every sum runs in the same order on any number of threads), on
+// the dense default (Fig. 1, 𝕄 reused) and on the matrix-free default (ten flagella, the far
+// field by the FMM, forced), 60 steps of 1 ms.
+TEST(FastPath, TwoThreadsStepAsOne) {
+  Model fmm = ModelFromToml(TenFlagella("mobility = \"matrix_free\""));
+  fmm.hydro.mobility.direct_sum_below = 0.0;
+  fmm.hydro.mobility.fast_sum_by_cost = false;
+  const Model fig1 = ModelFromToml(Fig1("", 65));
+  const Model* const fmm_model = &fmm;
+  const int saved = omp_get_max_threads();
+  for (const auto& [model, name] : {std::pair{&fig1, "Fig. 1, dense default"},
+                                    std::pair{fmm_model, "10 flagella, matrix-free + FMM"}}) {
+    omp_set_num_threads(1);
+    const Series one = RunSeries(*model, 60, 10, 1e-3);
+    omp_set_num_threads(2);
+    const Series two = RunSeries(*model, 60, 10, 1e-3);
+    ASSERT_EQ(one.q.size(), two.q.size());
+    double dq = 0.0, df = 0.0;
+    for (std::size_t i = 0; i < one.q.size(); ++i) {
+      dq = std::max(dq, (one.q[i] - two.q[i]).cwiseAbs().maxCoeff());
+      df = std::max(df, (one.clamp_force[i] - two.clamp_force[i]).cwiseAbs().maxCoeff());
+    }
+    std::printf("%s: two threads against one, max |Δq| = %.3e m, max |Δ clamp load| = %.3e N\n",
+                name, dq, df);
+    EXPECT_EQ(dq, 0.0) << name;
+    EXPECT_EQ(df, 0.0) << name;
+  }
+  omp_set_num_threads(saved);
 }
 
 // A wall: the helix of examples/helix_near_wall.toml turned 2 helix radii from the plane
