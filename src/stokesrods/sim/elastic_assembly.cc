@@ -28,8 +28,8 @@ struct EdgeTerms {
 //     is taken by cross products instead of forming ∂κb/∂e (κb = 2 e0 × e1 / D):
 //       (∂κb/∂e)ᵀ w = ((2/D) e1 × w − (κb·w/D) ∇_e0 D,  (2/D) w × e0 − (κb·w/D) ∇_e1 D),
 //     ∇_e0 D = |e1| t0 + e1, ∇_e1 D = |e0| t1 + e0.
-// tests/sim/elastic_assembly_test.cc compares it with the per-stencil path (the one taken with
-// the Jacobian).
+// ElasticAssembly.* (tests/sim/jacobian_test.cc) compares it with the per-stencil path (the one
+// taken with the Jacobian).
 double AddElasticForcesOnly(const RodModel& rod, const VecX& q, const RodFrames& frames,
                             VecX* force) {
   const int n = rod.num_nodes();
