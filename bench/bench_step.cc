@@ -57,7 +57,12 @@ void BM_RssMobilityAssembly(benchmark::State& st) {
 }
 BENCHMARK(BM_RssMobilityAssembly)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 
-void BM_ElasticForcesAndJacobian(benchmark::State& st) {
+// One rod's elastic assembly: by edges (AddElasticForces) or by the reference path, stencil by
+// stencil (AddElasticForcesPerStencil).
+using ElasticAssembly = double (*)(const RodModel&, const VecX&, const RodFrames&, VecX*,
+                                   BandedMatrix*);
+
+void BM_ElasticForcesAndJacobian(benchmark::State& st, ElasticAssembly assemble) {
   const Model model = PaperModel(1, static_cast<int>(st.range(0)), "none", "implicit");
   const State rest = MakeRestState(model);
   BandedMatrix jac(model.num_dofs, 10);
@@ -65,26 +70,32 @@ void BM_ElasticForcesAndJacobian(benchmark::State& st) {
   for (auto _ : st) {
     force.setZero();
     jac.SetZero();
-    AddElasticForces(model.rods[0], rest.q, rest.rods[0], &force, &jac);
+    assemble(model.rods[0], rest.q, rest.rods[0], &force, &jac);
     benchmark::DoNotOptimize(force.data());
   }
   st.SetComplexityN(st.range(0));
 }
-BENCHMARK(BM_ElasticForcesAndJacobian)->RangeMultiplier(4)->Range(64, 4096)
-    ->Complexity(benchmark::oN)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_ElasticForcesAndJacobian, by_edges, &AddElasticForces)
+    ->RangeMultiplier(4)->Range(64, 4096)->Complexity(benchmark::oN)
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_ElasticForcesAndJacobian, per_stencil, &AddElasticForcesPerStencil)
+    ->Arg(64)->Unit(benchmark::kMicrosecond);
 
 // The forces alone (the Newton test's evaluation at each trial point).
-void BM_ElasticForces(benchmark::State& st) {
+void BM_ElasticForces(benchmark::State& st, ElasticAssembly assemble) {
   const Model model = PaperModel(1, static_cast<int>(st.range(0)), "none", "implicit");
   const State rest = MakeRestState(model);
   VecX force(model.num_dofs);
   for (auto _ : st) {
     force.setZero();
-    AddElasticForces(model.rods[0], rest.q, rest.rods[0], &force, nullptr);
+    assemble(model.rods[0], rest.q, rest.rods[0], &force, nullptr);
     benchmark::DoNotOptimize(force.data());
   }
 }
-BENCHMARK(BM_ElasticForces)->Arg(64)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_ElasticForces, by_edges, &AddElasticForces)->Arg(64)
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_ElasticForces, per_stencil, &AddElasticForcesPerStencil)->Arg(64)
+    ->Unit(benchmark::kMicrosecond);
 
 // The banded Newton matrix of one rod (N nodes, 4N − 1 DOFs, half bandwidth 10): LU and one solve.
 BandedMatrix RandomRodJacobian(int nodes) {

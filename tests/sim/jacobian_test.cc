@@ -125,11 +125,13 @@ TEST(Jacobian, RotatingHelixInMotion) {
   EXPECT_LT(JacobianError(model, state, 0.01, state.q), 1e-6);
 }
 
-// The forces alone (AddElasticForces without a Jacobian: per edge, by cross products) against
-// the per-stencil path the Jacobian's assembly takes (elastic/bending.cc, twisting.cc).
-TEST(ElasticAssembly, TheForcesAloneAreThoseOfThePerStencilPath) {
-  // A driven helix after 30 steps (rest curvature and twist, frames transported, twisted), then
-  // moved at random by up to a fifth of an edge and twisted by up to 0.5 rad per edge.
+// AddElasticForces (by edges: each edge's terms once, the bending gradient by cross products,
+// the Jacobian gathered in one 8 × 8 matrix per stencil) against AddElasticForcesPerStencil (the
+// energies of elastic/, which tests/elastic/ checks against finite differences): forces, moments
+// and the Jacobian, with the Jacobian and without.
+TEST(ElasticAssembly, ByEdgesAsStencilByStencil) {
+  // The driven helix after 30 steps (rest curvature and twist, frames transported, twisted),
+  // then moved at random by up to a fifth of an edge and twisted by up to 0.5 rad per edge.
   const Model model = ModelFromToml(kHelix);
   State state = MakeRestState(model);
   Workspace ws(model);
@@ -143,24 +145,43 @@ TEST(ElasticAssembly, TheForcesAloneAreThoseOfThePerStencilPath) {
       q(k) += size * u(rng) * (k % 4 == 3 ? 2.5 : rod.rest_edge_length.minCoeff());
     std::vector<RodFrames> frames;
     TransportFrames(model, q, state.rods, &frames);
-    VecX reference = VecX::Zero(model.num_dofs), fast = VecX::Zero(model.num_dofs);
-    BandedMatrix jacobian(rod.num_dofs(), 10);
-    const double energy_reference = AddElasticForces(rod, q, frames[0], &reference, &jacobian);
-    const double energy_fast = AddElasticForces(rod, q, frames[0], &fast, nullptr);
+    VecX reference = VecX::Zero(model.num_dofs), with = reference, without = reference;
+    BandedMatrix jacobian_reference(rod.num_dofs(), 10), jacobian(rod.num_dofs(), 10);
+    const double energy_reference =
+        AddElasticForcesPerStencil(rod, q, frames[0], &reference, &jacobian_reference);
+    const double energy_with = AddElasticForces(rod, q, frames[0], &with, &jacobian);
+    const double energy_without = AddElasticForces(rod, q, frames[0], &without, nullptr);
     // The forces on the nodes and the moments on the twist angles, each against its largest.
     for (const bool moments : {false, true}) {
       double scale = 0.0, error = 0.0;
       for (int k = 0; k < rod.num_dofs(); ++k) {
         if ((k % 4 == 3) != moments) continue;
         scale = std::max(scale, std::abs(reference(k)));
-        error = std::max(error, std::abs(fast(k) - reference(k)));
+        error = std::max({error, std::abs(with(k) - reference(k)), std::abs(without(k) - reference(k))});
       }
       std::printf("moved by %.0e edges: %s apart by %.2e of the largest (%.3e)\n", size,
                   moments ? "moments" : "forces", error / scale, scale);
       EXPECT_GT(scale, 0.0);
       EXPECT_LT(error, 1e-12 * scale) << (moments ? "moments" : "forces") << ", moved by " << size;
     }
-    EXPECT_NEAR(energy_fast, energy_reference, 1e-12 * energy_reference);
+    const MatX dense_reference = jacobian_reference.ToDense();
+    const double jacobian_error = (jacobian.ToDense() - dense_reference).norm() / dense_reference.norm();
+    // Bending and twisting alone (the stretching terms, EA ≫ EI/l², would hide them).
+    RodModel soft = rod;
+    soft.axial_stiffness = 0.0;
+    BandedMatrix soft_reference(rod.num_dofs(), 10), soft_jacobian(rod.num_dofs(), 10);
+    VecX scratch = VecX::Zero(model.num_dofs);
+    AddElasticForcesPerStencil(soft, q, frames[0], &scratch, &soft_reference);
+    AddElasticForces(soft, q, frames[0], &scratch, &soft_jacobian);
+    const MatX soft_dense = soft_reference.ToDense();
+    const double soft_error = (soft_jacobian.ToDense() - soft_dense).cwiseAbs().maxCoeff() /
+                              soft_dense.cwiseAbs().maxCoeff();
+    std::printf("moved by %.0e edges: Jacobians apart by %.2e (relative Frobenius), without "
+                "stretching by %.2e of the largest entry\n", size, jacobian_error, soft_error);
+    EXPECT_LT(jacobian_error, 1e-12) << "moved by " << size;
+    EXPECT_LT(soft_error, 1e-12) << "moved by " << size;
+    EXPECT_NEAR(energy_with, energy_reference, 1e-12 * energy_reference);
+    EXPECT_NEAR(energy_without, energy_reference, 1e-12 * energy_reference);
   }
 }
 

@@ -3,7 +3,6 @@
 #include <vector>
 
 #include "stokesrods/common/assert.h"
-
 #include "stokesrods/elastic/bending.h"
 #include "stokesrods/elastic/stretching.h"
 #include "stokesrods/elastic/twisting.h"
@@ -12,6 +11,17 @@ namespace stokesrods {
 
 namespace {
 
+// The stretching Hessian of an edge (DOFs a … a + 2 and b … b + 2) into the rod's matrix.
+void AddStretchingBlocks(int a, int b, const Mat6& h6, BandedMatrix* hessian) {
+  hessian->AddBlock(a, h6.topLeftCorner<3, 3>());
+  hessian->AddBlock(b, h6.bottomRightCorner<3, 3>());
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) {
+      (*hessian)(a + r, b + c) += h6(r, 3 + c);
+      (*hessian)(b + r, a + c) += h6(3 + r, c);
+    }
+}
+
 // What the stencils of both its nodes share about an edge.
 struct EdgeTerms {
   Vec3 e;         // x_{j+1} − x_j
@@ -19,19 +29,64 @@ struct EdgeTerms {
   Vec3 m1, m2;    // material directors
 };
 
-// The forces alone, without the Jacobian (Newton evaluates them at every trial point, twice a
-// step where the Jacobian is kept). The arithmetic of StretchingEnergy, BendingEdgeEnergy and
-// TwistingEdgeEnergy, arranged so that
-//   - each edge's vector, length and material directors are computed once (one sine and one
-//     cosine per edge, where the stencils' own calls take two per stencil), and
-//   - the bending gradient in the edges, ½ k Σ_a Δκ_a (∂κb/∂e)ᵀ (u_a⁰ + u_a¹) = (∂κb/∂e)ᵀ w,
-//     is taken by cross products instead of forming ∂κb/∂e (κb = 2 e0 × e1 / D):
-//       (∂κb/∂e)ᵀ w = ((2/D) e1 × w − (κb·w/D) ∇_e0 D,  (2/D) w × e0 − (κb·w/D) ∇_e1 D),
-//     ∇_e0 D = |e1| t0 + e1, ∇_e1 D = |e0| t1 + e0.
-// ElasticAssembly.* (tests/sim/jacobian_test.cc) compares it with the per-stencil path (the one
-// taken with the Jacobian).
-double AddElasticForcesOnly(const RodModel& rod, const VecX& q, const RodFrames& frames,
-                            VecX* force) {
+// The Jacobian of the stencil's bending and twisting gradient in y = (e0, θ0, e1, θ1), the
+// formulas of BendingEdgeEnergy and TwistingEdgeEnergy gathered into one 8 × 8 matrix:
+//   k Σ_a ∇κ_a ∇κ_aᵀ + k_t ∇τ ∇τᵀ                                   (the rank-3 part)
+//   + ½ ∇²(w·κb) − Σ_j (½/l_j) (∂κb/∂e)ᵀ t_j u_jᵀ   (columns of e_j)   (bending, edges)
+//   + k_t Δτ [∂κb/∂e_j / (2 l_i) − δ_ij κb t_iᵀ / (2 l_i²)]            (twisting, edges)
+//   −½ u_j·κb on (θ_j, θ_j), ½ (∂κb/∂e)ᵀ u'_j on (e, θ_j) and (θ_j, e),
+// u_j = k (Δκ⁽¹⁾ m2^j − Δκ⁽²⁾ m1^j), u'_j = −k (Δκ⁽¹⁾ m1^j + Δκ⁽²⁾ m2^j), w = u_0 + u_1.
+struct StencilJacobianTerms {
+  const StencilCurvature* c;
+  Vec8 grad[2];       // ∇κ⁽¹⁾, ∇κ⁽²⁾
+  Vec8 twist_grad;    // ∇τ
+  double bend = 0.0, twist_stiffness = 0.0, twist_moment = 0.0;  // k, k_t, k_t Δτ
+  Vec3 u[2], du[2];   // u_j, u'_j
+};
+
+Mat8 StencilJacobian(const StencilJacobianTerms& t) {
+  const StencilCurvature& c = *t.c;
+  Eigen::Matrix<double, 8, 3> g, weighted;
+  g << t.grad[0], t.grad[1], t.twist_grad;
+  weighted << t.bend * t.grad[0], t.bend * t.grad[1], t.twist_stiffness * t.twist_grad;
+  Mat8 h;
+  h.noalias() = weighted * g.transpose();
+  Mat6 edges = 0.5 * CalcCurvatureBinormalHessian(c, t.u[0] + t.u[1]);
+  const Eigen::Matrix<double, 6, 3> jt = c.jacobian.transpose();
+  for (int j = 0; j < 2; ++j) {
+    edges.middleCols<3>(3 * j).noalias() -= (0.5 / c.length[j]) * (jt * c.tangent[j]) * t.u[j].transpose();
+    edges.middleRows<3>(3 * j) += (0.5 * t.twist_moment / c.length[j]) * c.jacobian;
+    edges.block<3, 3>(3 * j, 3 * j).noalias() -=
+        (0.5 * t.twist_moment / (c.length[j] * c.length[j])) * c.kb * c.tangent[j].transpose();
+  }
+  const int edge_index[2] = {kEdge0, kEdge1};
+  const int theta_index[2] = {kTheta0, kTheta1};
+  for (int a = 0; a < 2; ++a)
+    for (int b = 0; b < 2; ++b) h.block<3, 3>(edge_index[a], edge_index[b]) += edges.block<3, 3>(3 * a, 3 * b);
+  for (int j = 0; j < 2; ++j) {
+    const int th = theta_index[j];
+    h(th, th) -= 0.5 * t.u[j].dot(c.kb);
+    const Vec6 mixed = 0.5 * jt * t.du[j];
+    for (int a = 0; a < 2; ++a) {
+      h.block<3, 1>(edge_index[a], th) += mixed.segment<3>(3 * a);
+      h.block<1, 3>(th, edge_index[a]) += mixed.segment<3>(3 * a).transpose();
+    }
+  }
+  return h;
+}
+
+// The forces, and the Jacobian where `hessian` is given, by edges: each edge's vector, length and
+// material directors are computed once (one sine and one cosine per edge, where the stencils'
+// own calls take two per stencil), and the bending gradient in the edges,
+// ½ k Σ_a Δκ_a (∂κb/∂e)ᵀ (u_a⁰ + u_a¹) = (∂κb/∂e)ᵀ w, is taken by cross products instead of
+// forming ∂κb/∂e (κb = 2 e0 × e1 / D):
+//   (∂κb/∂e)ᵀ w = ((2/D) e1 × w − (κb·w/D) ∇_e0 D,  (2/D) w × e0 − (κb·w/D) ∇_e1 D),
+//   ∇_e0 D = |e1| t0 + e1, ∇_e1 D = |e0| t1 + e0;
+// the Jacobian by StencilJacobian. The arithmetic of StretchingEnergy, BendingEdgeEnergy and
+// TwistingEdgeEnergy otherwise; ElasticAssembly.* (tests/sim/jacobian_test.cc) compares it with
+// AddElasticForcesPerStencil.
+double AddElasticForcesByEdge(const RodModel& rod, const VecX& q, const RodFrames& frames,
+                              VecX* force, BandedMatrix* hessian) {
   const int n = rod.num_nodes();
   const int o = rod.dof_offset;
   auto x = [&](int i) { return Vec3(q.segment<3>(o + NodeDof(i))); };
@@ -39,16 +94,20 @@ double AddElasticForcesOnly(const RodModel& rod, const VecX& q, const RodFrames&
   thread_local std::vector<EdgeTerms> edges;  // kept: no allocation per evaluation
   edges.resize(static_cast<size_t>(n - 1));
   Vec6 g6;
+  Mat6 h6;
   for (int j = 0; j + 1 < n; ++j) {
     EdgeTerms& edge = edges[static_cast<size_t>(j)];
     edge.e = x(j + 1) - x(j);
     edge.length = edge.e.norm();
     MaterialFrame(frames.frames[static_cast<size_t>(j)], q(o + TwistDof(j)), &edge.m1, &edge.m2);
     energy += StretchingEnergy({rod.axial_stiffness, rod.rest_edge_length(j)}, x(j), x(j + 1),
-                               &g6, nullptr);
+                               &g6, hessian ? &h6 : nullptr);
     force->segment<3>(o + NodeDof(j)) -= g6.head<3>();
     force->segment<3>(o + NodeDof(j + 1)) -= g6.tail<3>();
+    if (hessian) AddStretchingBlocks(NodeDof(j), NodeDof(j + 1), h6, hessian);
   }
+  StencilCurvature c;
+  StencilJacobianTerms terms;
   for (int i = 1; i + 1 < n; ++i) {
     const EdgeTerms& a = edges[static_cast<size_t>(i - 1)];
     const EdgeTerms& b = edges[static_cast<size_t>(i)];
@@ -79,12 +138,29 @@ double AddElasticForcesOnly(const RodModel& rod, const VecX& q, const RodFrames&
     const double g_theta1 =
         -0.5 * bend * (excess[0] * b.m1.dot(kb) + excess[1] * b.m2.dot(kb)) + twist_moment;
     // −Mᵀ g to the stencil (x_{i−1}, θ_{i−1}, x_i, θ_i, x_{i+1}), as EdgeToStencilGradient.
-    double* f = force->data() + o + NodeDof(i - 1);
+    const int first = NodeDof(i - 1);  // the stencil is 11 consecutive DOFs
+    double* f = force->data() + o + first;
     Eigen::Map<Vec3>(f) += g_e0;
     f[3] -= g_theta0;
     Eigen::Map<Vec3>(f + 4) -= g_e0 - g_e1;
     f[7] -= g_theta1;
     Eigen::Map<Vec3>(f + 8) -= g_e1;
+    if (!hessian) continue;
+    c = CalcStencilCurvature(a.e, b.e, true);
+    terms.c = &c;
+    const Vec6 grad_e[2] = {0.5 * c.jacobian.transpose() * m2, -0.5 * c.jacobian.transpose() * m1};
+    terms.grad[0] << grad_e[0].head<3>(), -0.5 * a.m1.dot(c.kb), grad_e[0].tail<3>(), -0.5 * b.m1.dot(c.kb);
+    terms.grad[1] << grad_e[1].head<3>(), -0.5 * a.m2.dot(c.kb), grad_e[1].tail<3>(), -0.5 * b.m2.dot(c.kb);
+    terms.twist_grad << c.kb / (2.0 * a.length), -1.0, c.kb / (2.0 * b.length), 1.0;
+    terms.bend = bend;
+    terms.twist_stiffness = twist_stiffness;
+    terms.twist_moment = twist_moment;
+    const EdgeTerms* edge[2] = {&a, &b};
+    for (int j = 0; j < 2; ++j) {
+      terms.u[j] = bend * (excess[0] * edge[j]->m2 - excess[1] * edge[j]->m1);
+      terms.du[j] = -bend * (excess[0] * edge[j]->m1 + excess[1] * edge[j]->m2);
+    }
+    hessian->AddBlock(first, EdgeToStencilHessian(StencilJacobian(terms)));
   }
   return energy;
 }
@@ -93,7 +169,12 @@ double AddElasticForcesOnly(const RodModel& rod, const VecX& q, const RodFrames&
 
 double AddElasticForces(const RodModel& rod, const VecX& q, const RodFrames& frames, VecX* force,
                         BandedMatrix* hessian) {
-  if (force && !hessian) return AddElasticForcesOnly(rod, q, frames, force);
+  if (force) return AddElasticForcesByEdge(rod, q, frames, force, hessian);
+  return AddElasticForcesPerStencil(rod, q, frames, force, hessian);
+}
+
+double AddElasticForcesPerStencil(const RodModel& rod, const VecX& q, const RodFrames& frames,
+                                  VecX* force, BandedMatrix* hessian) {
   const int n = rod.num_nodes();
   const int o = rod.dof_offset;
   auto x = [&](int i) { return Vec3(q.segment<3>(o + NodeDof(i))); };
@@ -111,15 +192,7 @@ double AddElasticForces(const RodModel& rod, const VecX& q, const RodFrames& fra
       force->segment<3>(o + a) -= g6.head<3>();
       force->segment<3>(o + b) -= g6.tail<3>();
     }
-    if (hessian) {
-      hessian->AddBlock(a, h6.topLeftCorner<3, 3>());
-      hessian->AddBlock(b, h6.bottomRightCorner<3, 3>());
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) {
-          (*hessian)(a + r, b + c) += h6(r, 3 + c);
-          (*hessian)(b + r, a + c) += h6(3 + r, c);
-        }
-    }
+    if (hessian) AddStretchingBlocks(a, b, h6, hessian);
   }
 
   // Bending and twisting at node i share the curvature of the stencil (DOFs 4(i−1) … 4(i+1)+2)

@@ -11,7 +11,13 @@ namespace stokesrods {
 /// Elastic energy [J] of `rod` at the global DOF vector q, with `frames` transported to q.
 /// Adds −∂E/∂q into the rod's entries of the global `force` and ∂²E/∂q² into `hessian` (the rod's
 /// banded matrix, local indices) when they are not null.
+/// Computed by edges (each edge's terms once for its two stencils; sim/elastic_assembly.cc).
 double AddElasticForces(const RodModel& rod, const VecX& q, const RodFrames& frames, VecX* force,
                         BandedMatrix* hessian);
+
+/// The same stencil by stencil, each by the energies of elastic/ (which tests/elastic/ checks
+/// against finite differences): the reference AddElasticForces is tested against.
+double AddElasticForcesPerStencil(const RodModel& rod, const VecX& q, const RodFrames& frames,
+                                  VecX* force, BandedMatrix* hessian);
 
 }  // namespace stokesrods

@@ -33,8 +33,11 @@ class BandedMatrix {
   /// Adds the dense block `block` with its top-left corner at (first, first).
   template <typename Derived>
   void AddBlock(int first, const Eigen::MatrixBase<Derived>& block) {
+    // A column of the block is a contiguous run of the band storage (Index below): added as a
+    // vector (element by element, the compiler could not rule out that it aliases the block).
+    using Column = Eigen::Matrix<double, Derived::RowsAtCompileTime, 1>;
     for (int c = 0; c < block.cols(); ++c)
-      for (int r = 0; r < block.rows(); ++r) (*this)(first + r, first + c) += block(r, c);
+      Eigen::Map<Column>(ab_.data() + Index(first, first + c), block.rows()) += block.col(c);
   }
 
   /// Replaces row and column k by those of the identity (a fixed DOF).
