@@ -157,7 +157,8 @@ TEST(ElasticAssembly, ByEdgesAsStencilByStencil) {
       for (int k = 0; k < rod.num_dofs(); ++k) {
         if ((k % 4 == 3) != moments) continue;
         scale = std::max(scale, std::abs(reference(k)));
-        error = std::max({error, std::abs(with(k) - reference(k)), std::abs(without(k) - reference(k))});
+        error = std::max({error, std::abs(with(k) - reference(k)),
+                          std::abs(without(k) - reference(k))});
       }
       std::printf("moved by %.0e edges: %s apart by %.2e of the largest (%.3e)\n", size,
                   moments ? "moments" : "forces", error / scale, scale);
@@ -165,7 +166,8 @@ TEST(ElasticAssembly, ByEdgesAsStencilByStencil) {
       EXPECT_LT(error, 1e-12 * scale) << (moments ? "moments" : "forces") << ", moved by " << size;
     }
     const MatX dense_reference = jacobian_reference.ToDense();
-    const double jacobian_error = (jacobian.ToDense() - dense_reference).norm() / dense_reference.norm();
+    const double jacobian_error =
+        (jacobian.ToDense() - dense_reference).norm() / dense_reference.norm();
     // Bending and twisting alone (the stretching terms, EA ≫ EI/l², would hide them).
     RodModel soft = rod;
     soft.axial_stiffness = 0.0;

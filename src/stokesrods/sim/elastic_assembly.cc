@@ -29,47 +29,54 @@ struct EdgeTerms {
   Vec3 m1, m2;    // material directors
 };
 
-// The Jacobian of the stencil's bending and twisting gradient in y = (e0, θ0, e1, θ1), the
-// formulas of BendingEdgeEnergy and TwistingEdgeEnergy gathered into one 8 × 8 matrix:
+// The Jacobian of the stencil's bending and twisting gradient in y = (e0, θ0, e1, θ1) (edges a,
+// b; k = bend, Δκ = excess, k_t = twist_stiffness, k_t Δτ = twist_moment), the formulas of
+// BendingEdgeEnergy and TwistingEdgeEnergy gathered into one 8 × 8 matrix:
 //   k Σ_a ∇κ_a ∇κ_aᵀ + k_t ∇τ ∇τᵀ                                   (the rank-3 part)
 //   + ½ ∇²(w·κb) − Σ_j (½/l_j) (∂κb/∂e)ᵀ t_j u_jᵀ   (columns of e_j)   (bending, edges)
 //   + k_t Δτ [∂κb/∂e_j / (2 l_i) − δ_ij κb t_iᵀ / (2 l_i²)]            (twisting, edges)
 //   −½ u_j·κb on (θ_j, θ_j), ½ (∂κb/∂e)ᵀ u'_j on (e, θ_j) and (θ_j, e),
 // u_j = k (Δκ⁽¹⁾ m2^j − Δκ⁽²⁾ m1^j), u'_j = −k (Δκ⁽¹⁾ m1^j + Δκ⁽²⁾ m2^j), w = u_0 + u_1.
-struct StencilJacobianTerms {
-  const StencilCurvature* c;
-  Vec8 grad[2];       // ∇κ⁽¹⁾, ∇κ⁽²⁾
-  Vec8 twist_grad;    // ∇τ
-  double bend = 0.0, twist_stiffness = 0.0, twist_moment = 0.0;  // k, k_t, k_t Δτ
-  Vec3 u[2], du[2];   // u_j, u'_j
-};
-
-Mat8 StencilJacobian(const StencilJacobianTerms& t) {
-  const StencilCurvature& c = *t.c;
-  Eigen::Matrix<double, 8, 3> g, weighted;
-  g << t.grad[0], t.grad[1], t.twist_grad;
-  weighted << t.bend * t.grad[0], t.bend * t.grad[1], t.twist_stiffness * t.twist_grad;
-  Mat8 h;
-  h.noalias() = weighted * g.transpose();
-  Mat6 edges = 0.5 * CalcCurvatureBinormalHessian(c, t.u[0] + t.u[1]);
+Mat8 StencilJacobian(const EdgeTerms& a, const EdgeTerms& b, double bend, const Vec2& excess,
+                     double twist_stiffness, double twist_moment) {
+  const StencilCurvature c = CalcStencilCurvature(a.e, b.e, true);
   const Eigen::Matrix<double, 6, 3> jt = c.jacobian.transpose();
+  // The gradients of κ⁽¹⁾, κ⁽²⁾ and τ, and u_j, u'_j.
+  const Vec6 grad_e[2] = {0.5 * jt * (a.m2 + b.m2), -0.5 * jt * (a.m1 + b.m1)};
+  Eigen::Matrix<double, 8, 3> g;
+  g.col(0) << grad_e[0].head<3>(), -0.5 * a.m1.dot(c.kb), grad_e[0].tail<3>(),
+      -0.5 * b.m1.dot(c.kb);
+  g.col(1) << grad_e[1].head<3>(), -0.5 * a.m2.dot(c.kb), grad_e[1].tail<3>(),
+      -0.5 * b.m2.dot(c.kb);
+  g.col(2) << c.kb / (2.0 * a.length), -1.0, c.kb / (2.0 * b.length), 1.0;
+  const EdgeTerms* edge[2] = {&a, &b};
+  Vec3 u[2], du[2];
   for (int j = 0; j < 2; ++j) {
-    edges.middleCols<3>(3 * j).noalias() -= (0.5 / c.length[j]) * (jt * c.tangent[j]) * t.u[j].transpose();
-    edges.middleRows<3>(3 * j) += (0.5 * t.twist_moment / c.length[j]) * c.jacobian;
+    u[j] = bend * (excess[0] * edge[j]->m2 - excess[1] * edge[j]->m1);
+    du[j] = -bend * (excess[0] * edge[j]->m1 + excess[1] * edge[j]->m2);
+  }
+  Mat8 h;
+  h.noalias() = g * Vec3(bend, bend, twist_stiffness).asDiagonal() * g.transpose();
+  Mat6 edges = 0.5 * CalcCurvatureBinormalHessian(c, u[0] + u[1]);
+  for (int j = 0; j < 2; ++j) {
+    edges.middleCols<3>(3 * j).noalias() -=
+        (0.5 / c.length[j]) * (jt * c.tangent[j]) * u[j].transpose();
+    edges.middleRows<3>(3 * j) += (0.5 * twist_moment / c.length[j]) * c.jacobian;
     edges.block<3, 3>(3 * j, 3 * j).noalias() -=
-        (0.5 * t.twist_moment / (c.length[j] * c.length[j])) * c.kb * c.tangent[j].transpose();
+        (0.5 * twist_moment / (c.length[j] * c.length[j])) * c.kb * c.tangent[j].transpose();
   }
   const int edge_index[2] = {kEdge0, kEdge1};
   const int theta_index[2] = {kTheta0, kTheta1};
-  for (int a = 0; a < 2; ++a)
-    for (int b = 0; b < 2; ++b) h.block<3, 3>(edge_index[a], edge_index[b]) += edges.block<3, 3>(3 * a, 3 * b);
+  for (int i = 0; i < 2; ++i)
+    for (int k = 0; k < 2; ++k)
+      h.block<3, 3>(edge_index[i], edge_index[k]) += edges.block<3, 3>(3 * i, 3 * k);
   for (int j = 0; j < 2; ++j) {
     const int th = theta_index[j];
-    h(th, th) -= 0.5 * t.u[j].dot(c.kb);
-    const Vec6 mixed = 0.5 * jt * t.du[j];
-    for (int a = 0; a < 2; ++a) {
-      h.block<3, 1>(edge_index[a], th) += mixed.segment<3>(3 * a);
-      h.block<1, 3>(th, edge_index[a]) += mixed.segment<3>(3 * a).transpose();
+    h(th, th) -= 0.5 * u[j].dot(c.kb);
+    const Vec6 mixed = 0.5 * jt * du[j];
+    for (int i = 0; i < 2; ++i) {
+      h.block<3, 1>(edge_index[i], th) += mixed.segment<3>(3 * i);
+      h.block<1, 3>(th, edge_index[i]) += mixed.segment<3>(3 * i).transpose();
     }
   }
   return h;
@@ -106,8 +113,6 @@ double AddElasticForcesByEdge(const RodModel& rod, const VecX& q, const RodFrame
     force->segment<3>(o + NodeDof(j + 1)) -= g6.tail<3>();
     if (hessian) AddStretchingBlocks(NodeDof(j), NodeDof(j + 1), h6, hessian);
   }
-  StencilCurvature c;
-  StencilJacobianTerms terms;
   for (int i = 1; i + 1 < n; ++i) {
     const EdgeTerms& a = edges[static_cast<size_t>(i - 1)];
     const EdgeTerms& b = edges[static_cast<size_t>(i)];
@@ -118,7 +123,8 @@ double AddElasticForcesByEdge(const RodModel& rod, const VecX& q, const RodFrame
     // Bending: κ⁽¹⁾ = ½ (m2⁰ + m2¹)·κb, κ⁽²⁾ = −½ (m1⁰ + m1¹)·κb (paper eq. 3).
     const double bend = rod.bending_stiffness / dl;
     const Vec3 m1 = a.m1 + b.m1, m2 = a.m2 + b.m2;
-    const Vec2 excess = Vec2(0.5 * m2.dot(kb), -0.5 * m1.dot(kb)) - rod.rest_curvature[static_cast<size_t>(i)];
+    const Vec2 excess = Vec2(0.5 * m2.dot(kb), -0.5 * m1.dot(kb)) -
+                        rod.rest_curvature[static_cast<size_t>(i)];
     energy += 0.5 * bend * excess.squaredNorm();
     // Twisting: τ = θ1 − θ0 + m_ref (paper eq. 4), ∂m_ref/∂e_j = κb / (2|e_j|).
     const double twist_stiffness = rod.twisting_stiffness / dl;
@@ -145,22 +151,9 @@ double AddElasticForcesByEdge(const RodModel& rod, const VecX& q, const RodFrame
     Eigen::Map<Vec3>(f + 4) -= g_e0 - g_e1;
     f[7] -= g_theta1;
     Eigen::Map<Vec3>(f + 8) -= g_e1;
-    if (!hessian) continue;
-    c = CalcStencilCurvature(a.e, b.e, true);
-    terms.c = &c;
-    const Vec6 grad_e[2] = {0.5 * c.jacobian.transpose() * m2, -0.5 * c.jacobian.transpose() * m1};
-    terms.grad[0] << grad_e[0].head<3>(), -0.5 * a.m1.dot(c.kb), grad_e[0].tail<3>(), -0.5 * b.m1.dot(c.kb);
-    terms.grad[1] << grad_e[1].head<3>(), -0.5 * a.m2.dot(c.kb), grad_e[1].tail<3>(), -0.5 * b.m2.dot(c.kb);
-    terms.twist_grad << c.kb / (2.0 * a.length), -1.0, c.kb / (2.0 * b.length), 1.0;
-    terms.bend = bend;
-    terms.twist_stiffness = twist_stiffness;
-    terms.twist_moment = twist_moment;
-    const EdgeTerms* edge[2] = {&a, &b};
-    for (int j = 0; j < 2; ++j) {
-      terms.u[j] = bend * (excess[0] * edge[j]->m2 - excess[1] * edge[j]->m1);
-      terms.du[j] = -bend * (excess[0] * edge[j]->m1 + excess[1] * edge[j]->m2);
-    }
-    hessian->AddBlock(first, EdgeToStencilHessian(StencilJacobian(terms)));
+    if (hessian)
+      hessian->AddBlock(first, EdgeToStencilHessian(StencilJacobian(
+                                   a, b, bend, excess, twist_stiffness, twist_moment)));
   }
   return energy;
 }
