@@ -135,22 +135,15 @@ double AddElasticForcesByEdge(const RodModel& rod, const VecX& q, const RodFrame
     // The gradient in (e0, θ0, e1, θ1).
     const Vec3 w = (0.5 * bend) * (excess[0] * m2 - excess[1] * m1);
     const double kb_w = kb.dot(w) / d;
-    const Vec3 g_e0 = (2.0 / d) * b.e.cross(w) - kb_w * ((b.length / a.length) * a.e + b.e) +
-                      (0.5 * twist_moment / a.length) * kb;
-    const Vec3 g_e1 = (2.0 / d) * w.cross(a.e) - kb_w * ((a.length / b.length) * b.e + a.e) +
-                      (0.5 * twist_moment / b.length) * kb;
-    const double g_theta0 =
-        -0.5 * bend * (excess[0] * a.m1.dot(kb) + excess[1] * a.m2.dot(kb)) - twist_moment;
-    const double g_theta1 =
+    Vec8 g;
+    g << (2.0 / d) * b.e.cross(w) - kb_w * ((b.length / a.length) * a.e + b.e) +
+             (0.5 * twist_moment / a.length) * kb,
+        -0.5 * bend * (excess[0] * a.m1.dot(kb) + excess[1] * a.m2.dot(kb)) - twist_moment,
+        (2.0 / d) * w.cross(a.e) - kb_w * ((a.length / b.length) * b.e + a.e) +
+            (0.5 * twist_moment / b.length) * kb,
         -0.5 * bend * (excess[0] * b.m1.dot(kb) + excess[1] * b.m2.dot(kb)) + twist_moment;
-    // −Mᵀ g to the stencil (x_{i−1}, θ_{i−1}, x_i, θ_i, x_{i+1}), as EdgeToStencilGradient.
     const int first = NodeDof(i - 1);  // the stencil is 11 consecutive DOFs
-    double* f = force->data() + o + first;
-    Eigen::Map<Vec3>(f) += g_e0;
-    f[3] -= g_theta0;
-    Eigen::Map<Vec3>(f + 4) -= g_e0 - g_e1;
-    f[7] -= g_theta1;
-    Eigen::Map<Vec3>(f + 8) -= g_e1;
+    force->segment<11>(o + first) -= EdgeToStencilGradient(g);
     if (hessian)
       hessian->AddBlock(first, EdgeToStencilHessian(StencilJacobian(
                                    a, b, bend, excess, twist_stiffness, twist_moment)));
