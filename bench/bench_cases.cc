@@ -278,6 +278,7 @@ int RunCase(const Options& options, const CaseSpec& spec, nlohmann::ordered_json
   long newton = 0, krylov = 0;
   const MobilityReuseStats reuse_start =
       ws.nonlocal_fluid ? ws.hydro.mobility().reuse_stats() : MobilityReuseStats{};
+  const long builds_start = ws.nonlocal_fluid ? ws.hydro.preconditioner_builds() : 0;
   std::FILE* step_times = nullptr;
   if (!options.step_times.empty()) {
     step_times = std::fopen(options.step_times.c_str(), "w");
@@ -320,6 +321,10 @@ int RunCase(const Options& options, const CaseSpec& spec, nlohmann::ordered_json
   j["newton_per_step"] = Number(ms.empty() ? std::nan("") : static_cast<double>(newton) / n);
   j["krylov_per_step"] = Number(ms.empty() ? std::nan("") : static_cast<double>(krylov) / n);
   j["wall_s_per_sim_s"] = Number(mean * 1e-3 / h);
+  if (ws.nonlocal_fluid)  // of the Krylov preconditioner
+    j["preconditioner_builds_per_step"] = Number(
+        ms.empty() ? std::nan("")
+                   : static_cast<double>(ws.hydro.preconditioner_builds() - builds_start) / n);
   // The reuse of the dense 𝕄, or of the matrix-free operator's near corrections.
   if (ws.nonlocal_fluid && ws.hydro.mobility().reuse_stats().updates > 0) {
     const MobilityReuseStats reuse = ws.hydro.mobility().reuse_stats();

@@ -94,13 +94,14 @@ def differences(reference, candidate):
                 j.pop("wall_seconds")
                 j.pop("mobility_reuse", None)
                 j.pop("krylov_products", None)
+                j.pop("preconditioner_builds", None)
                 j["config"]["run"].pop("output")
                 j["config"]["run"].pop("checkpoint_wall_interval", None)
             if ja != jb:
                 keys = sorted(k for k in set(ja) | set(jb) if ja.get(k) != jb.get(k))
                 detail = "; ".join(f"{k}: {ja.get(k)} vs {jb.get(k)}" for k in keys)
-                problems.append("summary.json differs beyond wall_seconds, mobility_reuse and "
-                                f"krylov_products ({detail})")
+                problems.append("summary.json differs beyond wall_seconds, mobility_reuse, "
+                                f"krylov_products and preconditioner_builds ({detail})")
         elif not filecmp.cmp(a, b, shallow=False):
             problems.append(f"{name} differs")
     return problems

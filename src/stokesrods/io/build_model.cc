@@ -191,6 +191,7 @@ Model BuildModel(const Config& config) {
   model.hydro.solver =
       config.fluid.solver == "direct" ? HydroSolver::kDirect : HydroSolver::kKrylov;
   model.hydro.krylov_tolerance = config.fluid.krylov_tolerance;
+  model.hydro.rotate_preconditioner = config.fluid.krylov_rotate_preconditioner;
   model.hydro.mobility.tolerance = config.fluid.far_field_tolerance;
   model.hydro.mobility.fast_sum_tolerance = config.fluid.fast_sum_tolerance;
   // Cell bodies: the far-field sum in single precision (from 1e-4) is not linear to round-off, and

@@ -58,6 +58,7 @@ struct FluidConfig {
   double mobility_reuse_tolerance = 1e-4;  ///< dense: error of 𝕄 reused across steps [–]
   std::string solver = "krylov";      ///< implicit coupling: "krylov" (GMRES) | "direct" (dense LU)
   double krylov_tolerance = 1e-6;     ///< GMRES relative residual [–]
+  bool krylov_rotate_preconditioner = true;  ///< the kept preconditioner follows the rods' rotation
 };
 
 struct ContactConfig {

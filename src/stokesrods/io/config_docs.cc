@@ -38,6 +38,7 @@ const std::map<std::string, std::string>& Meanings() {
       {"fluid.mobility_reuse_tolerance", "RSS: the dense 𝕄, or the matrix-free operator's near corrections (where its far sum is in single precision, fast_sum_tolerance ≥ 1e-4), are extrapolated from their last assemblies between steps while their measured relative error (Frobenius) stays below this (the near corrections while their pattern of near pairs holds); 0 assembles them at every step; summary.json mobility_reuse"},
       {"fluid.solver", "implicit coupling: \"krylov\" (GMRES) or \"direct\" (dense LU; dense mobility only)"},
       {"fluid.krylov_tolerance", "GMRES relative residual"},
+      {"fluid.krylov_rotate_preconditioner", "GMRES: the preconditioner kept across steps is applied in each rod's frame turned by the rod's best-fit rotation since it was built; false applies it as built. A preconditioner only: the solution and its tolerance do not change, the GMRES products do"},
       {"contact.enabled", "rod–rod and self contact (paper section 2.3), of rods with the wall and the bodies, and of the bodies with each other and the wall"},
       {"contact.tolerance", "a contact is resolved when every distance ≥ (r_a + r_b)(1 − tolerance)"},
       {"contact.max_rounds", "solve–detect–re-solve rounds per step before a numerical failure"},

@@ -34,6 +34,7 @@ void VisitFields(FluidConfig& c, V& v) {
   v("mobility_reuse_tolerance", c.mobility_reuse_tolerance);
   v("solver", c.solver);
   v("krylov_tolerance", c.krylov_tolerance);
+  v("krylov_rotate_preconditioner", c.krylov_rotate_preconditioner);
 }
 template <class V>
 void VisitFields(ContactConfig& c, V& v) {

@@ -99,6 +99,7 @@ class Observer {
                              {"largest_error", result.mobility_reuse.largest_error},
                              {"measurements", result.mobility_reuse.measurements}};
     s["krylov_products"] = result.krylov_products;
+    s["preconditioner_builds"] = result.preconditioner_builds;
     s["version"] = STOKESRODS_VERSION;
     WriteFileAtomically((fs::path(plan_.output_dir) / "summary.json").string(), s.dump(2) + "\n");
   }
@@ -317,6 +318,7 @@ RunResult RunCase(const Config& config, const RunOptions& options) {
   if (ws.nonlocal_fluid) {
     result.mobility_reuse = ws.hydro.mobility().reuse_stats();
     result.krylov_products = ws.hydro.krylov_iterations();
+    result.preconditioner_builds = ws.hydro.preconditioner_builds();
   }
   if (options.progress) options.progress({state.time, plan.duration, result.wall_seconds, state.step});
   observer.WriteSummary(result.status, result.message, result, counters.max_penetration);

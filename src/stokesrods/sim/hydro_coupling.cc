@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/SVD>
+
 #include "stokesrods/common/assert.h"
 #include "stokesrods/fluid/mobility_sources.h"
 #include "stokesrods/fluid/wall_sources.h"
@@ -63,10 +65,17 @@ constexpr int kFullLuBelow = 3000;
 // needs 1.85 GMRES products per step at 40 (1.58 at 20, 2.01 at 60), and a rebuild (the Schur
 // blocks and the LU of C) costs as much as ~27 products: 40 is the cheaper (docs/performance.md).
 constexpr int kPreconditionerMaxAge = 40;
+// A rebuild of the dense preconditioner (the Schur blocks and the float LU of C) in GMRES
+// products (a product with 𝕄, the banded solves and a preconditioner solve): rebuilt once the
+// solves since the last rebuild have taken this many products beyond the first solve's count
+// each. Measured on Fig. 1 (390 × 390, docs/performance.md, session 19).
+constexpr int kRebuildCostInProducts = 24;
+constexpr int kBlockRebuildCostInProducts = 8;
 
 void HydroCoupling::Init(const Model& model) {
   mobility_ = MakeModelMobility(model);
   krylov_ = model.hydro.solver == HydroSolver::kKrylov;
+  rotate_preconditioner_ = model.hydro.rotate_preconditioner;
   explicit_ = model.coupling == FluidCoupling::kExplicit;
   // The whole capacitance's LU while it is small; above 3(M + P) = 3000 its O((3(M + P))³)
   // rebuilds cost more than the extra GMRES products of the block preconditioner
@@ -87,6 +96,7 @@ HydroSolveReport HydroCoupling::Prepare(const Model& model, const VecX& q_start,
   mobility_->UpdateWithBodies(MakeHydroRods(model, positions_), bodies_);
   mobility_changed_ = true;
   ++preconditioner_age_;
+  UpdatePreconditionerRotations(model);
   HydroSolveReport report;
   if (!explicit_) return report;
   // The explicit drag: 𝕄 f = −U(t_k).
@@ -136,6 +146,8 @@ void HydroCoupling::ForgetReuse(const VecX& drag_guess) {
   preconditioner_age_ = 0;
   iterations_after_refresh_ = -1;
   wants_refresh_ = false;
+  excess_products_ = 0;
+  preconditioner_rotations_ = RodRotations{};
   mobility_changed_ = true;
   explicit_blocks_.reset();
   explicit_blocks_age_ = 0;
@@ -176,6 +188,11 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
     preconditioner_h_ = h;
     preconditioner_age_ = 0;
     iterations_after_refresh_ = -1;
+    excess_products_ = 0;
+    ++preconditioner_builds_;
+    preconditioner_rotations_ = RodRotations{};
+    if (rotate_preconditioner_ && krylov_)
+      preconditioner_positions_ = positions_;
     BuildSchurBlocks(model);
     if (block_preconditioner_) {
       std::vector<MatX> blocks(model.rods.size());
@@ -255,11 +272,60 @@ void HydroCoupling::ApplyCapacitance(const Model& model, double h, const VecX& v
   if (borders_) ApplyClampBorders(model, h, *borders_, v, scratch_dofs_, out);
 }
 
+void HydroCoupling::UpdatePreconditionerRotations(const Model& model) {
+  if (!rotate_preconditioner_ || !have_preconditioner_ ||
+      preconditioner_positions_.size() != positions_.size())
+    return;
+  RodRotations& q = preconditioner_rotations_;
+  q.rotation.resize(positions_.size());
+  q.first_node.resize(positions_.size());
+  q.nodes.resize(positions_.size());
+  for (std::size_t r = 0; r < positions_.size(); ++r) {
+    q.first_node[r] = model.rods[r].node_offset;
+    q.nodes[r] = model.rods[r].num_nodes();
+    q.rotation[r] = Mat3::Identity();
+    // A rod clamped on a body turns with it; its cell's block holds the body's points, which
+    // stay as built: the rod's block is applied as built too.
+    if (model.rods[r].body >= 0) continue;
+    // Kabsch: the rotation R maximizing Σ (x_i − x̄)ᵀ R (x⁰_i − x̄⁰) is U diag(1, 1, ±1) Vᵀ
+    // from the SVD U Σ Vᵀ of Σ (x_i − x̄)(x⁰_i − x̄⁰)ᵀ, the sign making det R = +1.
+    const Matrix3X& before = preconditioner_positions_[r];
+    const Matrix3X& now = positions_[r];
+    const Mat3 covariance = (now.colwise() - now.rowwise().mean()) *
+                            (before.colwise() - before.rowwise().mean()).transpose();
+    const Eigen::JacobiSVD<Mat3> svd(covariance, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Mat3 sign = Mat3::Identity();
+    if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0) sign(2, 2) = -1.0;
+    q.rotation[r] = svd.matrixU() * sign * svd.matrixV().transpose();
+  }
+}
+
+void RodRotations::Apply(bool transpose, VecX* x) const {
+  for (std::size_t r = 0; r < rotation.size(); ++r) {
+    const Mat3 q = transpose ? Mat3(rotation[r].transpose()) : rotation[r];
+    for (int i = first_node[r]; i < first_node[r] + nodes[r]; ++i) {
+      const Vec3 turned = q * x->segment<3>(3 * i);
+      x->segment<3>(3 * i) = turned;
+    }
+  }
+}
+
 void HydroCoupling::Precondition(const VecX& v, VecX* out) const {
-  if (block_preconditioner_) return capacitance_blocks_.Apply(v, out);
-  Eigen::VectorXf x = v.cast<float>();
-  capacitance_lu_float_.Solve(&x);
-  *out = x.cast<double>();
+  const RodRotations& q = preconditioner_rotations_;
+  const VecX* in = &v;
+  if (!q.empty()) {  // Q P₀ Qᵀ v
+    scratch_ = v;
+    q.Apply(true, &scratch_);
+    in = &scratch_;
+  }
+  if (block_preconditioner_) {
+    capacitance_blocks_.Apply(*in, out);
+  } else {
+    Eigen::VectorXf x = in->cast<float>();
+    capacitance_lu_float_.Solve(&x);
+    *out = x.cast<double>();
+  }
+  if (!q.empty()) q.Apply(false, out);
 }
 
 HydroSolveReport HydroCoupling::SolveNewtonSystem(const Model& model,
@@ -315,7 +381,10 @@ HydroSolveReport HydroCoupling::SolveNewtonSystem(const Model& model,
     if (!g.converged && (worst_solve_.ok || g.relative_residual > worst_solve_.relative_residual))
       worst_solve_ = report;
     if (iterations_after_refresh_ < 0) iterations_after_refresh_ = g.iterations;
-    wants_refresh_ = g.iterations > 2 * iterations_after_refresh_ + 2;
+    excess_products_ += std::max(0, g.iterations - iterations_after_refresh_);
+    wants_refresh_ = g.iterations > 2 * iterations_after_refresh_ + 2 ||
+                     excess_products_ >= (block_preconditioner_ ? kBlockRebuildCostInProducts
+                                                                : kRebuildCostInProducts);
   }
   // δq = y + X δf = y + B⁻¹ Sᵀ δf;  du = S δq/h + 𝕄 δf = (S y + C δf)/h.
   if (x_df.size() == 0) SolveBanded(model, *df, nullptr, &x_df);  // direct, or δf = 0

@@ -16,6 +16,19 @@
 //           else (matrix-free, or larger): blocks per rod and per body, bordered by the free
 //           bodies' motions (sim/capacitance_preconditioner.h), and a coarse level
 //           (sim/coarse_level.h: W ≈ C Z by a point Stokeslet per chunk, never stored).
+// The kept preconditioner follows the rods' rotation (model.hydro.rotate_preconditioner): rod k's
+// nodes turned rigidly by R_k turn its 𝕄 and elastic blocks into R_k(·)R_kᵀ (the RSS kernel and
+// the elastic energy are invariant under rotation), so P₀ ≈ C₀⁻¹, built at the nodes X₀, is
+// applied as Q P₀ Qᵀ, Q = diag(R_k) on each rod's nodes, R_k the rotation that best maps the
+// rod's nodes at X₀ onto its nodes now (least squares about their centroids: Kabsch). The
+// blocks between rods turned about different axes, and what deforms, are left to GMRES; rods
+// clamped on a body, whose cell block holds the body's points, keep R_k = I. Fig. 1 turns each
+// helix 0.063 rad per step at h = 40 ms. It is rebuilt when the solves since the rebuild have
+// taken, beyond the first solve's count each, as many GMRES products as a rebuild costs
+// (kRebuildCostInProducts), or when one solve took more than twice the first's plus two.
+// Measured (docs/performance.md, session 19): Fig. 1 over 75 s at h = 40 ms 27 196 → 14 798
+// products; ten helices at h = 10 ms 23.3 → 11.9 per step; unchanged at h = 1 ms from ten
+// helices up.
 // Since r_u is linear in (q, f), after a full Newton step it is the GMRES residual / h; along a
 // damped step it changes linearly, so line-search trials need no product with 𝕄.
 #pragma once
@@ -35,6 +48,17 @@
 #include "stokesrods/solver/dense_lu.h"
 
 namespace stokesrods {
+
+/// Per rod, a rotation R_k of its nodes' entries (3 per node from 3 first_node[k]); the other
+/// entries (the bodies' points, the free bodies' motions) are left as they are.
+struct RodRotations {
+  std::vector<Mat3> rotation;   ///< per rod; empty: none
+  std::vector<int> first_node;  ///< per rod
+  std::vector<int> nodes;       ///< per rod
+  bool empty() const { return rotation.empty(); }
+  /// x ← Q x, or Qᵀ x when `transpose`.
+  void Apply(bool transpose, VecX* x) const;
+};
 
 struct HydroSolveReport {
   bool ok = true;
@@ -105,6 +129,7 @@ class HydroCoupling {
   const HydroSolveReport& worst_solve() const { return worst_solve_; }
   void ResetSolveReport() { worst_solve_ = HydroSolveReport{}; }
   long krylov_iterations() const { return krylov_total_; }  ///< over the whole run
+  long preconditioner_builds() const { return preconditioner_builds_; }  ///< over the whole run
 
  private:
   void ApplyCapacitance(const Model& model, double h, const VecX& v, VecX* out) const;
@@ -114,6 +139,8 @@ class HydroCoupling {
   std::vector<ClampBorder>* borders_ = nullptr;  ///< of the last FactorizeNewtonSystem
   mutable VecX scratch_dofs_;
   void Precondition(const VecX& v, VecX* out) const;
+  // R_k of each rod since the preconditioner was built (dense capacitance LU only; see above).
+  void UpdatePreconditionerRotations(const Model& model);
 
   std::unique_ptr<MobilityOperator> mobility_;
   std::vector<Matrix3X> positions_;  ///< at the last Prepare (the operator points into them)
@@ -135,6 +162,11 @@ class HydroCoupling {
   double preconditioner_h_ = -1.0;
   int preconditioner_age_ = 0;     ///< steps (Prepare calls) since the preconditioner was built
   bool wants_refresh_ = false;
+  bool rotate_preconditioner_ = false;
+  std::vector<Matrix3X> preconditioner_positions_;  ///< the rods' nodes when it was built
+  RodRotations preconditioner_rotations_;           ///< R_k; empty: applied as built
+  int excess_products_ = 0;  ///< GMRES products beyond the first solve's since the rebuild
+  long preconditioner_builds_ = 0;
   long krylov_total_ = 0;
   HydroSolveReport worst_solve_;
   DenseLu<double> explicit_lu_;  ///< the explicit coupling's LU of a dense 𝕄 (every step)

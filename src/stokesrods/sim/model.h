@@ -106,6 +106,9 @@ struct HydroOptions {
   MobilityOptions mobility;                    ///< dense or matrix-free 𝕄
   HydroSolver solver = HydroSolver::kKrylov;
   double krylov_tolerance = 1e-6;              ///< GMRES: |b − C x| ≤ this × |b|  [–]
+  /// GMRES: the kept preconditioner follows each rod's rotation since it was built
+  /// (sim/hydro_coupling.h); false applies it as built (the reference).
+  bool rotate_preconditioner = true;
 };
 
 struct Model {
