@@ -65,10 +65,13 @@ constexpr int kFullLuBelow = 3000;
 // needs 1.85 GMRES products per step at 40 (1.58 at 20, 2.01 at 60), and a rebuild (the Schur
 // blocks and the LU of C) costs as much as ~27 products: 40 is the cheaper (docs/performance.md).
 constexpr int kPreconditionerMaxAge = 40;
-// A rebuild of the dense preconditioner (the Schur blocks and the float LU of C) in GMRES
-// products (a product with 𝕄, the banded solves and a preconditioner solve): rebuilt once the
-// solves since the last rebuild have taken this many products beyond the first solve's count
-// each. Measured on Fig. 1 (390 × 390, docs/performance.md, session 19).
+// What a rebuild of the preconditioner costs in GMRES products (a product with 𝕄, its banded
+// solves and a preconditioner solve): it is rebuilt once the solves since the last rebuild have
+// taken this many products beyond the first solve's count each (rent or buy). The dense LU (the
+// Schur blocks and the float LU of C): fitted on Fig. 1 over 75 s at h = 40 ms (390 × 390: a
+// rebuild 1.45 ms, a product 60 µs). The two levels (the blocks' Schur parts and LUs, the coarse
+// level): on ten helices at h = 10 ms 4, 8, 12, 24 and 48 were tried, 8 the fastest
+// (docs/performance.md, session 19).
 constexpr int kRebuildCostInProducts = 24;
 constexpr int kBlockRebuildCostInProducts = 8;
 

@@ -21,7 +21,8 @@
 // the elastic energy are invariant under rotation), so P₀ ≈ C₀⁻¹, built at the nodes X₀, is
 // applied as Q P₀ Qᵀ, Q = diag(R_k) on each rod's nodes, R_k the rotation that best maps the
 // rod's nodes at X₀ onto its nodes now (least squares about their centroids: Kabsch). The
-// blocks between rods turned about different axes, and what deforms, are left to GMRES; rods
+// blocks between rods turned about different axes, a wall's images, and what deforms, are left
+// to GMRES; rods
 // clamped on a body, whose cell block holds the body's points, keep R_k = I. Fig. 1 turns each
 // helix 0.063 rad per step at h = 40 ms. It is rebuilt when the solves since the rebuild have
 // taken, beyond the first solve's count each, as many GMRES products as a rebuild costs
@@ -139,7 +140,7 @@ class HydroCoupling {
   std::vector<ClampBorder>* borders_ = nullptr;  ///< of the last FactorizeNewtonSystem
   mutable VecX scratch_dofs_;
   void Precondition(const VecX& v, VecX* out) const;
-  // R_k of each rod since the preconditioner was built (dense capacitance LU only; see above).
+  // R_k of each rod since the preconditioner was built (see above).
   void UpdatePreconditionerRotations(const Model& model);
 
   std::unique_ptr<MobilityOperator> mobility_;
