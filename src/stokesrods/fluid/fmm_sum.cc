@@ -59,18 +59,29 @@ extern "C" void dgemm_(const char* transa, const char* transb, const int* m, con
                        const double* b, const int* ldb, const double* beta, double* c,
                        const int* ldc);
 
-/// c = alpha op(a) b + beta c by the BLAS (OpenBLAS: its kernels for the CPU at hand, on one
-/// thread so that the result does not depend on the thread count (solver/blas.h); the build
-/// itself targets baseline x86-64, where Eigen's products are 5–10× slower).
-void Gemm(const MatX& a, bool transpose_a, const MatX& b, double alpha, double beta, MatX* c) {
+/// c = alpha a b by the BLAS (OpenBLAS: its kernels for the CPU at hand, on one thread so that
+/// the result does not depend on the thread count (solver/blas.h); the build itself targets
+/// baseline x86-64, where Eigen's products are 5–10× slower), over fixed blocks of kGemmColumns
+/// columns spread over the OpenMP threads: each column is that of its block's product, whatever
+/// the number of threads. (One product on one thread, the fits and translations were the largest
+/// serial part of a two-thread step on a hundred helices: docs/performance.md, session 19.)
+constexpr Eigen::Index kGemmColumns = 64;
+void GemmByColumns(const MatX& a, const MatX& b, double alpha, MatX* c) {
   SR_ASSERT(BlasIsSingleThreaded(), "the BLAS must run on one thread");
-  const int m = static_cast<int>(transpose_a ? a.cols() : a.rows());
-  const int n = static_cast<int>(b.cols()), k = static_cast<int>(b.rows());
-  if (beta == 0.0) c->resize(m, n);
-  if (m == 0 || n == 0) return;
-  const int lda = static_cast<int>(a.rows()), ldb = k, ldc = m;
-  const char ta = transpose_a ? 'T' : 'N', tb = 'N';
-  dgemm_(&ta, &tb, &m, &n, &k, &alpha, a.data(), &lda, b.data(), &ldb, &beta, c->data(), &ldc);
+  SR_ASSERT(b.rows() == a.cols(), "GemmByColumns: sizes");
+  c->resize(a.rows(), b.cols());
+  const int m = static_cast<int>(a.rows()), k = static_cast<int>(a.cols());
+  if (m == 0 || b.cols() == 0) return;
+  const Eigen::Index blocks = (b.cols() + kGemmColumns - 1) / kGemmColumns;
+#pragma omp parallel for schedule(static) if (blocks > 1)
+  for (Eigen::Index block = 0; block < blocks; ++block) {
+    const Eigen::Index first = block * kGemmColumns;
+    const int n = static_cast<int>(std::min(kGemmColumns, b.cols() - first));
+    const char no = 'N';
+    const double zero = 0.0;
+    dgemm_(&no, &no, &m, &n, &k, &alpha, a.data(), &m, b.data() + first * k, &k, &zero,
+           c->data() + first * m, &m);
+  }
 }
 
 /// The translations between levels (M2M, L2L) of many boxes: out_j = ops[octant_j] in.col(column_j)
@@ -88,7 +99,7 @@ void TranslateByOctant(const std::array<MatX, 8>& ops, const MatX& in,
   for (std::size_t o = 0; o < 8; ++o) gathered[o].resize(in.rows(), count[o]);
   for (std::size_t j = 0; j < column.size(); ++j)
     gathered[static_cast<size_t>(octant[j])].col((*slot)[j]) = in.col(column[j]);
-  for (std::size_t o = 0; o < 8; ++o) Gemm(ops[o], false, gathered[o], 1.0, 0.0, &(*products)[o]);
+  for (std::size_t o = 0; o < 8; ++o) GemmByColumns(ops[o], gathered[o], 1.0, &(*products)[o]);
 }
 
 class FmmStokesletSum final : public StokesletSum {
@@ -286,7 +297,7 @@ void FmmStokesletSum::Upward() const {
       }
     }
   }
-  Gemm(op_->check_to_up, false, check, width, 0.0, &up_[static_cast<size_t>(leaf)]);
+  GemmByColumns(op_->check_to_up, check, width, &up_[static_cast<size_t>(leaf)]);
   std::array<MatX, 8> moved;
   std::vector<int> column, octant, slot;
   for (int l = leaf - 1; l >= 2; --l) {
@@ -325,7 +336,7 @@ void FmmStokesletSum::Downward() const {
     M2l(l);
     const auto& boxes = tree_.levels[static_cast<size_t>(l)];
     MatX& down = down_[static_cast<size_t>(l)];
-    Gemm(op_->check_to_down, false, check_[static_cast<size_t>(l)], 1.0, 0.0, &down);
+    GemmByColumns(op_->check_to_down, check_[static_cast<size_t>(l)], 1.0, &down);
     if (l == 2) continue;
     column.clear();
     octant.clear();

@@ -176,8 +176,11 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
                                           std::vector<BandedMatrix>* jacobian,
                                           std::vector<ClampBorder>* borders) {
   SR_ASSERT(!explicit_, "the capacitance solve is for the implicit coupling");
-  for (BandedMatrix& b : *jacobian)
-    if (!b.Factorize()) return false;
+  const int num_rods = static_cast<int>(jacobian->size());
+  bool regular = true;
+#pragma omp parallel for schedule(static) reduction(&& : regular) if (num_rods > 1)
+  for (int r = 0; r < num_rods; ++r) regular = (*jacobian)[static_cast<size_t>(r)].Factorize() && regular;
+  if (!regular) return false;
   jacobian_ = jacobian;
   borders_ = borders;
   if (borders) CompleteClampBorders(model, *jacobian, borders);
@@ -228,7 +231,10 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
 
 void HydroCoupling::BuildSchurBlocks(const Model& model) {
   sx_blocks_.resize(model.rods.size());
-  for (std::size_t r = 0; r < model.rods.size(); ++r) {
+  const int num_rods = static_cast<int>(model.rods.size());
+#pragma omp parallel for schedule(dynamic) if (num_rods > 1)
+  for (int ri = 0; ri < num_rods; ++ri) {  // each rod's own block (and its borders' rows)
+    const auto r = static_cast<std::size_t>(ri);
     const RodModel& rod = model.rods[r];
     const int n = rod.num_nodes();
     // X_k = B_k⁻¹ S_kᵀ: a unit right-hand side per free position DOF (fixed ones stay zero).
@@ -283,7 +289,10 @@ void HydroCoupling::UpdatePreconditionerRotations(const Model& model) {
   q.rotation.resize(positions_.size());
   q.first_node.resize(positions_.size());
   q.nodes.resize(positions_.size());
-  for (std::size_t r = 0; r < positions_.size(); ++r) {
+  const int num_rods = static_cast<int>(positions_.size());
+#pragma omp parallel for schedule(static) if (num_rods > 1)
+  for (int ri = 0; ri < num_rods; ++ri) {
+    const auto r = static_cast<std::size_t>(ri);
     q.first_node[r] = model.rods[r].node_offset;
     q.nodes[r] = model.rods[r].num_nodes();
     q.rotation[r] = Mat3::Identity();
