@@ -54,7 +54,7 @@ struct RunResult {
   MobilityReuseStats mobility_reuse;
   /// GMRES products (fluid.solver = "krylov"), counted like wall_seconds.
   long krylov_products = 0;
-  long preconditioner_builds = 0;  ///< of the Krylov preconditioner (HydroCoupling)
+  long preconditioner_builds = 0;  ///< of C's Krylov preconditioner, or its LU (direct)
 };
 
 /// Runs the configured case and writes its outputs. Throws ConfigError (bad input) and IoError

@@ -197,8 +197,7 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
     excess_products_ = 0;
     ++preconditioner_builds_;
     preconditioner_rotations_ = RodRotations{};
-    if (rotate_preconditioner_ && krylov_)
-      preconditioner_positions_ = positions_;
+    if (rotate_preconditioner_ && krylov_) StartPreconditionerRotations(model);
     BuildSchurBlocks(model);
     if (block_preconditioner_) {
       std::vector<MatX> blocks(model.rods.size());
@@ -281,30 +280,40 @@ void HydroCoupling::ApplyCapacitance(const Model& model, double h, const VecX& v
   if (borders_) ApplyClampBorders(model, h, *borders_, v, scratch_dofs_, out);
 }
 
+void HydroCoupling::StartPreconditionerRotations(const Model& model) {
+  // The rods' nodes about their centroids at the build, and where each rod's entries sit; the
+  // rotations themselves come with the next Prepare (none until then: built where it stands).
+  const std::size_t num_rods = positions_.size();
+  preconditioner_positions_.resize(num_rods);
+  RodRotations& q = preconditioner_rotations_;
+  q.first_node.resize(num_rods);
+  q.nodes.resize(num_rods);
+  for (std::size_t r = 0; r < num_rods; ++r) {
+    preconditioner_positions_[r] = positions_[r].colwise() - positions_[r].rowwise().mean();
+    q.first_node[r] = model.rods[r].node_offset;
+    q.nodes[r] = model.rods[r].num_nodes();
+  }
+}
+
 void HydroCoupling::UpdatePreconditionerRotations(const Model& model) {
   if (!rotate_preconditioner_ || !have_preconditioner_ ||
       preconditioner_positions_.size() != positions_.size())
     return;
   RodRotations& q = preconditioner_rotations_;
   q.rotation.resize(positions_.size());
-  q.first_node.resize(positions_.size());
-  q.nodes.resize(positions_.size());
   const int num_rods = static_cast<int>(positions_.size());
 #pragma omp parallel for schedule(static) if (num_rods > 1)
   for (int ri = 0; ri < num_rods; ++ri) {
     const auto r = static_cast<std::size_t>(ri);
-    q.first_node[r] = model.rods[r].node_offset;
-    q.nodes[r] = model.rods[r].num_nodes();
     q.rotation[r] = Mat3::Identity();
     // A rod clamped on a body turns with it; its cell's block holds the body's points, which
     // stay as built: the rod's block is applied as built too.
     if (model.rods[r].body >= 0) continue;
     // Kabsch: the rotation R maximizing Σ (x_i − x̄)ᵀ R (x⁰_i − x̄⁰) is U diag(1, 1, ±1) Vᵀ
     // from the SVD U Σ Vᵀ of Σ (x_i − x̄)(x⁰_i − x̄⁰)ᵀ, the sign making det R = +1.
-    const Matrix3X& before = preconditioner_positions_[r];
     const Matrix3X& now = positions_[r];
-    const Mat3 covariance = (now.colwise() - now.rowwise().mean()) *
-                            (before.colwise() - before.rowwise().mean()).transpose();
+    const Mat3 covariance =
+        (now.colwise() - now.rowwise().mean()) * preconditioner_positions_[r].transpose();
     const Eigen::JacobiSVD<Mat3> svd(covariance, Eigen::ComputeFullU | Eigen::ComputeFullV);
     Mat3 sign = Mat3::Identity();
     if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0) sign(2, 2) = -1.0;

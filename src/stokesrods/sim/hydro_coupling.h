@@ -140,7 +140,9 @@ class HydroCoupling {
   std::vector<ClampBorder>* borders_ = nullptr;  ///< of the last FactorizeNewtonSystem
   mutable VecX scratch_dofs_;
   void Precondition(const VecX& v, VecX* out) const;
-  // R_k of each rod since the preconditioner was built (see above).
+  // At a rebuild: the rods' nodes about their centroids, and the rotations' layout.
+  void StartPreconditionerRotations(const Model& model);
+  // R_k of each rod since the preconditioner was built (see above), at every Prepare.
   void UpdatePreconditionerRotations(const Model& model);
 
   std::unique_ptr<MobilityOperator> mobility_;
@@ -164,7 +166,8 @@ class HydroCoupling {
   int preconditioner_age_ = 0;     ///< steps (Prepare calls) since the preconditioner was built
   bool wants_refresh_ = false;
   bool rotate_preconditioner_ = false;
-  std::vector<Matrix3X> preconditioner_positions_;  ///< the rods' nodes when it was built
+  std::vector<Matrix3X> preconditioner_positions_;  ///< the rods' nodes when it was built,
+                                                    ///< about their centroids
   RodRotations preconditioner_rotations_;           ///< R_k; empty: applied as built
   int excess_products_ = 0;  ///< GMRES products beyond the first solve's since the rebuild
   long preconditioner_builds_ = 0;
