@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -147,6 +148,91 @@ TEST(BroadPhase, MediumSoupEqualsBruteForce) {
   const std::vector<Matrix3X> rods = RandomSoup(&rng, 60, 41, 20.0);
   EXPECT_EQ(FindCandidatePairs(Pointers(rods), 0.25, 3),
             FindCandidatePairsBruteForce(Pointers(rods), 0.25, 3));
+}
+
+// The list kept across calls (a Verlet list) against a new search at every call: the rods of a
+// soup drift by small random steps (each coordinate by up to a tenth of the margin per call, so
+// that the list is found again every few calls), and at every call the list must hold every pair
+// of FindCandidatePairs, sorted. A list kept past the skin's half (the validity test off by a
+// factor 4) loses pairs here: 0.5 s → 2 s misses some of them within the 200 calls.
+TEST(CandidatePairList, HoldsEveryPairOfANewSearchAsTheRodsMove) {
+  std::mt19937 rng(11);
+  std::vector<Matrix3X> rods = RandomSoup(&rng, 12, 20, 12.0);
+  std::uniform_real_distribution<double> drift(-1.0, 1.0);
+  const double margin = 0.3;
+  CandidatePairList list;
+  int calls = 0;
+  std::size_t most_pairs = 0;
+  for (int call = 0; call < 200; ++call, ++calls) {
+    for (Matrix3X& x : rods)
+      for (Eigen::Index i = 0; i < x.cols(); ++i)
+        x.col(i) += 0.1 * margin * Vec3(drift(rng), drift(rng), drift(rng));
+    const std::vector<SegmentPair> exact = FindCandidatePairs(Pointers(rods), margin, 1);
+    const std::vector<SegmentPair>& kept = list.Pairs(Pointers(rods), margin, 1);
+    ASSERT_TRUE(Sorted(kept));
+    ASSERT_TRUE(std::includes(kept.begin(), kept.end(), exact.begin(), exact.end(),
+                              [](const SegmentPair& p, const SegmentPair& q) {
+                                return std::array<int, 4>{p.a.rod, p.a.index, p.b.rod, p.b.index} <
+                                       std::array<int, 4>{q.a.rod, q.a.index, q.b.rod, q.b.index};
+                              }))
+        << "call " << call;
+    most_pairs = std::max(most_pairs, exact.size());
+  }
+  EXPECT_GT(most_pairs, 10u);  // the soup has pairs to keep
+  // Found again every few calls (up to 0.05 of margin per call and coordinate on average), not at
+  // every call, and not only once.
+  EXPECT_GT(list.searches(), 10);
+  EXPECT_LT(list.searches(), calls / 2);
+}
+
+TEST(CandidatePairList, SearchesAgainOnAChangeOfRodsMarginOrExclusionAndOnNotANumber) {
+  std::mt19937 rng(5);
+  std::vector<Matrix3X> rods = RandomSoup(&rng, 4, 10, 4.0);
+  CandidatePairList list;
+  // Found with the skin (the margin grown by half of it), kept while nothing moves.
+  EXPECT_EQ(list.Pairs(Pointers(rods), 0.2, 1), FindCandidatePairs(Pointers(rods), 0.3, 1));
+  list.Pairs(Pointers(rods), 0.2, 1);
+  EXPECT_EQ(list.searches(), 1);
+  list.Pairs(Pointers(rods), 0.3, 1);  // a new margin: found again (the last list served 2 calls)
+  EXPECT_EQ(list.searches(), 2);
+  // A new exclusion: found again; the last list served one call only, so without the skin.
+  EXPECT_EQ(list.Pairs(Pointers(rods), 0.3, 2), FindCandidatePairs(Pointers(rods), 0.3, 2));
+  EXPECT_EQ(list.searches(), 3);
+  rods.pop_back();  // fewer rods
+  EXPECT_EQ(list.Pairs(Pointers(rods), 0.3, 2), FindCandidatePairs(Pointers(rods), 0.3, 2));
+  EXPECT_EQ(list.searches(), 4);
+  rods[0](1, 3) = std::numeric_limits<double>::quiet_NaN();  // not a number: found again
+  EXPECT_EQ(list.Pairs(Pointers(rods), 0.3, 2), FindCandidatePairs(Pointers(rods), 0.3, 2));
+  list.Pairs(Pointers(rods), 0.3, 2);  // a node that is not a number differs from itself
+  EXPECT_EQ(list.searches(), 6);
+}
+
+// Rods that move by more than the margin per call: every call searches, first with the skin, then
+// (the list having served one call) without it for 8 searches, then with it again; each call's
+// pairs hold FindCandidatePairs'.
+TEST(CandidatePairList, LargeMotionsSearchWithoutTheSkin) {
+  std::mt19937 rng(8);
+  std::vector<Matrix3X> rods = RandomSoup(&rng, 8, 15, 8.0);
+  const double margin = 0.2;
+  CandidatePairList list;
+  std::vector<bool> with_skin;
+  for (int call = 0; call < 20; ++call) {
+    for (Matrix3X& x : rods) x.colwise() += Vec3(0.0, 0.0, 0.5 * margin * (call % 2 == 0 ? 1 : -1));
+    for (Matrix3X& x : rods) x.col(0).x() += 2.0 * margin;  // one node moves by more than s/2
+    const std::vector<SegmentPair>& kept = list.Pairs(Pointers(rods), margin, 1);
+    const std::vector<SegmentPair> exact = FindCandidatePairs(Pointers(rods), margin, 1);
+    ASSERT_TRUE(std::includes(kept.begin(), kept.end(), exact.begin(), exact.end(),
+                              [](const SegmentPair& p, const SegmentPair& q) {
+                                return std::array<int, 4>{p.a.rod, p.a.index, p.b.rod, p.b.index} <
+                                       std::array<int, 4>{q.a.rod, q.a.index, q.b.rod, q.b.index};
+                              }));
+    with_skin.push_back(kept == FindCandidatePairs(Pointers(rods), 1.5 * margin, 1) &&
+                        kept != exact);
+    EXPECT_EQ(list.searches(), call + 1);
+  }
+  // Calls 0, 9 and 18 with the skin (a pair list that differs from the exact one), the others not.
+  for (int call = 0; call < 20; ++call)
+    EXPECT_EQ(with_skin[static_cast<std::size_t>(call)], call % 9 == 0) << "call " << call;
 }
 
 }  // namespace

@@ -305,5 +305,30 @@ TEST(ContactNormal, FallbacksAtZeroDistance) {
   }
 }
 
+// DetectContacts with the broad phase kept across calls (CandidatePairList) finds the same
+// contacts, bit for bit, as with a new search at each call, on two crossing rods that slide
+// through and past each other in small steps (contacts found, lost and found again).
+TEST(DetectContacts, KeptCandidateListFindsTheSameContacts) {
+  CandidatePairList list;
+  int with_contacts = 0;
+  for (int call = 0; call <= 400; ++call) {
+    const double z = -0.3 + 0.0015 * call;  // the second rod passes through the first
+    std::vector<Matrix3X> rods = {Nodes({{-1, 0, 0}, {-0.5, 0.02, 0}, {0, 0, 0}, {0.5, -0.02, 0}, {1, 0, 0}}),
+                                  Nodes({{0.1, -1, z}, {0.12, -0.4, z}, {0.1, 0.2, z}, {0.08, 1, z}})};
+    const auto fresh = DetectContacts(Pointers(rods), {0.1, 0.1}, 1);
+    const auto kept = DetectContacts(Pointers(rods), {0.1, 0.1}, 1, nullptr, &list);
+    ASSERT_EQ(fresh.size(), kept.size()) << "call " << call;
+    for (std::size_t k = 0; k < fresh.size(); ++k) {
+      EXPECT_EQ(fresh[k].segments, kept[k].segments);
+      EXPECT_EQ(fresh[k].penetration, kept[k].penetration);
+      EXPECT_EQ(fresh[k].normal, kept[k].normal);
+    }
+    with_contacts += fresh.empty() ? 0 : 1;
+  }
+  EXPECT_GT(with_contacts, 50);
+  EXPECT_LT(with_contacts, 350);
+  EXPECT_LT(list.searches(), 100);  // 0.0015 per call against a skin's half of 0.05
+}
+
 }  // namespace
 }  // namespace stokesrods

@@ -209,4 +209,38 @@ std::vector<SegmentPair> FindCandidatePairsBruteForce(const std::vector<const Ma
   return pairs;
 }
 
+const std::vector<SegmentPair>& CandidatePairList::Pairs(const std::vector<const Matrix3X*>& rods,
+                                                        double margin, int self_exclusion) {
+  CheckArguments(margin, self_exclusion);
+  bool valid = margin == margin_ && self_exclusion == self_exclusion_ &&
+               found_at_.size() == rods.size();
+  for (std::size_t r = 0; r < rods.size() && valid; ++r) {
+    SR_ASSERT(rods[r] != nullptr, "null rod");
+    const Matrix3X& now = *rods[r];
+    // Not valid on a non-finite coordinate either (the comparison is false).
+    valid = now.cols() == found_at_[r].cols() &&
+            (now.cols() == 0 ||
+             (now - found_at_[r]).cwiseAbs().maxCoeff<Eigen::PropagateNaN>() <= 0.5 * skin_);
+  }
+  if (valid) {
+    ++calls_;
+    return pairs_;
+  }
+  // A list with a skin that served only the call that found it (the rods move by more than half
+  // the skin per call: large time steps) cost a search with the larger margin for nothing: the
+  // next kPlainSearches are made without one (FindCandidatePairs' pairs exactly), then the skin is
+  // tried again.
+  if (skin_ > 0.0 && calls_ <= 1) plain_searches_left_ = kPlainSearches;
+  skin_ = plain_searches_left_ > 0 ? 0.0 : margin;
+  plain_searches_left_ = std::max(plain_searches_left_ - 1, 0);
+  pairs_ = FindCandidatePairs(rods, margin + 0.5 * skin_, self_exclusion);
+  ++searches_;
+  calls_ = 1;
+  margin_ = margin;
+  self_exclusion_ = self_exclusion;
+  found_at_.resize(rods.size());
+  for (std::size_t r = 0; r < rods.size(); ++r) found_at_[r] = *rods[r];
+  return pairs_;
+}
+
 }  // namespace stokesrods

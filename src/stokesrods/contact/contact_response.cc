@@ -102,7 +102,8 @@ Vec3 CalcContactNormal(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec
 
 std::vector<ContactPair> DetectContacts(const std::vector<const Matrix3X*>& rods,
                                         const std::vector<double>& radii, int self_exclusion,
-                                        const std::vector<ContactPair>* previous) {
+                                        const std::vector<ContactPair>* previous,
+                                        CandidatePairList* candidate_list) {
   SR_ASSERT(rods.size() == radii.size(), "one radius per rod");
   SR_ASSERT(self_exclusion >= 0, "self_exclusion must be >= 0");
   double max_radius = 0.0;
@@ -111,7 +112,10 @@ std::vector<ContactPair> DetectContacts(const std::vector<const Matrix3X*>& rods
     max_radius = std::max(max_radius, r);
   }
   // δ_min < r_a + r_b ≤ 2 max r implies boxes inflated by max r each overlap.
-  const std::vector<SegmentPair> candidates = FindCandidatePairs(rods, max_radius, self_exclusion);
+  std::vector<SegmentPair> found;
+  if (!candidate_list) found = FindCandidatePairs(rods, max_radius, self_exclusion);
+  const std::vector<SegmentPair>& candidates =
+      candidate_list ? candidate_list->Pairs(rods, max_radius, self_exclusion) : found;
 
   std::vector<ContactPair> contacts;
   for (const SegmentPair& pair : candidates) {

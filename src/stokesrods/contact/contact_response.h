@@ -52,9 +52,12 @@ Vec3 CalcContactNormal(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec
 ///    would be pushed twice.
 ///  - previous: the contacts of the previous detection (sorted, as returned), used for the normal
 ///    of pairs at distance ~0 (CalcContactNormal); may be null.
+///  - candidates: a broad phase kept across calls (CandidatePairList, broad_phase.h), or null for
+///    a new one (FindCandidatePairs); the contacts found are the same either way.
 std::vector<ContactPair> DetectContacts(const std::vector<const Matrix3X*>& rods,
                                         const std::vector<double>& radii, int self_exclusion,
-                                        const std::vector<ContactPair>* previous = nullptr);
+                                        const std::vector<ContactPair>* previous = nullptr,
+                                        CandidatePairList* candidates = nullptr);
 
 /// Adds to `displacements` (3 × N_r per rod, [m]) the nodal displacements that remove the
 /// penetration of `contact`:

@@ -177,9 +177,11 @@ void SummarizeOthers(const Model& model, const std::vector<ObstaclePair>& obstac
 
 ContactSummary AddContactForces(const Model& model, const VecX& q, double h,
                                 const LinearResponse& respond, VecX* contact_force,
-                                const std::vector<BodyPose>& poses, VecX* body_loads) {
+                                const std::vector<BodyPose>& poses, VecX* body_loads,
+                                CandidatePairList* candidates) {
   const ContactInput in = MakeInput(model, q);
-  const std::vector<ContactPair> pairs = DetectContacts(in.rods, in.radii, in.self_exclusion);
+  const std::vector<ContactPair> pairs =
+      DetectContacts(in.rods, in.radii, in.self_exclusion, nullptr, candidates);
   ContactSummary summary = Summarize(model, pairs);
   const bool have_poses = poses.size() == model.bodies.size();
   const std::vector<ObstaclePair> obstacles =

@@ -68,10 +68,11 @@ using LinearResponse =
 /// The rods' contacts with the wall and the bodies at `poses` (obstacle_contact.h) and the bodies'
 /// with each other and the wall (body_contact.h) join the same multipliers, W including the free
 /// bodies' motion under each pair's loads; those loads accumulate in `body_loads` (6 per free
-/// body).
+/// body). `candidates`: the broad phase kept across calls (CandidatePairList), or null.
 ContactSummary AddContactForces(const Model& model, const VecX& q, double h,
                                 const LinearResponse& respond, VecX* contact_force,
                                 const std::vector<BodyPose>& poses = {},
-                                VecX* body_loads = nullptr);
+                                VecX* body_loads = nullptr,
+                                CandidatePairList* candidates = nullptr);
 
 }  // namespace stokesrods

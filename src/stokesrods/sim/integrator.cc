@@ -283,7 +283,7 @@ StepReport StepOnce(const Model& model, double h, State* state, Workspace* ws) {
     std::vector<BodyPose> poses;  // at the step's end, with the current V
     if (!model.bodies.empty()) EndPoses(model, ws->body_step, ws->hydro_force, &poses);
     report.contact = AddContactForces(model, ws->q, he, respond, &ws->contact_force, poses,
-                                      &ws->body_load);
+                                      &ws->body_load, &ws->contact_candidates);
     if (report.contact.active == 0) break;  // report.contact describes the final state
     report.contact_pairs = std::max(report.contact_pairs, report.contact.detected);
     if (report.contact_rounds >= model.newton.max_contact_rounds) {

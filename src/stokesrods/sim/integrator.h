@@ -70,6 +70,7 @@ struct Workspace {
   VecX force;                    ///< F_int + F_ext + F^h + F^c at q (after a converged solve)
   VecX residual, residual_try, delta, simplified;
   VecX contact_force;            ///< F^c, constant during a Newton solve
+  CandidatePairList contact_candidates;  ///< the contact's broad phase, kept across steps
   /// The loads on the free bodies (force, torque about the centre; 6 each), constant in a Newton
   /// solve: their own (BodyModel::force, torque) and the contacts' reactions.
   VecX body_load;

@@ -29,8 +29,10 @@ GmresReport SolveGmres(const LinearOperatorWithSide& a, const LinearOperator& pr
   const int m = std::max(1, options.restart);
   MatX v(n, m + 1);             // Arnoldi basis
   MatX z(n, m);                 // preconditioned directions P⁻¹ v_j (flexible form: no re-apply)
-  MatX hess = MatX::Zero(m + 1, m);
-  MatX hess_raw = MatX::Zero(m + 1, m);  // H̄ before the rotations: A Z_k = V_{k+1} H̄_k
+  // Column k of both is zeroed at iteration k, when it is first written (not the whole (m + 1) × m
+  // at each cycle: with m = 50 that was 80 KB of zeros per solve, for 1–5 columns used).
+  MatX hess(m + 1, m);
+  MatX hess_raw(m + 1, m);  // H̄ before the rotations: A Z_k = V_{k+1} H̄_k
   VecX cs(m), sn(m), g(m + 1);
   VecX w(n), r(n);
   auto apply_p = [&](const VecX& in, VecX* out) {
@@ -71,8 +73,6 @@ GmresReport SolveGmres(const LinearOperatorWithSide& a, const LinearOperator& pr
     v.col(0) = r / r_norm;
     g.setZero();
     g(0) = r_norm;
-    hess.setZero();
-    hess_raw.setZero();
     int k = 0;
     for (; k < m && report.iterations < options.max_iterations; ++k) {
       VecX zk(n);
@@ -80,6 +80,7 @@ GmresReport SolveGmres(const LinearOperatorWithSide& a, const LinearOperator& pr
       z.col(k) = zk;
       a(zk, &w, side_of_x ? &side : nullptr);
       ++report.iterations;
+      hess.col(k).setZero();
       if (side_of_x) {
         if (sides.cols() != m) sides.resize(side.size(), m);
         sides.col(k) = side;
@@ -90,6 +91,7 @@ GmresReport SolveGmres(const LinearOperatorWithSide& a, const LinearOperator& pr
       }
       hess(k + 1, k) = w.norm();
       if (hess(k + 1, k) > 0.0) v.col(k + 1) = w / hess(k + 1, k);
+      hess_raw.col(k).setZero();  // below H̄'s subdiagonal: read by the products with it
       hess_raw.col(k).head(k + 2) = hess.col(k).head(k + 2);
       for (int i = 0; i < k; ++i) {  // previous rotations on the new column
         const double t = cs(i) * hess(i, k) + sn(i) * hess(i + 1, k);
