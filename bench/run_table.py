@@ -53,8 +53,14 @@ def parse_args():
     p.add_argument("--mem-limit-gb", type=float, default=8.0,
                    help="address-space limit of each case (RLIMIT_AS), capped at the memory "
                    "available minus 2 GB")
+    p.add_argument("--repeat", type=int, default=1,
+                   help="rounds of all the runs, one after the other (default 1): each row then "
+                   "gives the median run and the range, the exponent the fit of the medians and "
+                   "the range of the rounds' fits")
     p.add_argument("--json", metavar="OUT", help="write the raw results here")
     args = p.parse_args()
+    if args.repeat < 1:
+        p.error("--repeat takes an integer ≥ 1")
     args.cases = ALL_CASES if args.cases == "all" else [c for c in args.cases.split(",") if c]
     unknown = [c for c in args.cases if c not in ALL_CASES]
     if unknown:
@@ -218,6 +224,9 @@ def table(rows):
         note = "" if r["ok"] else "**" + r.get("message", "failed").replace("|", "/") + "**"
         if r["ok"] and r.get("steps") is not None:
             note = f"{r['steps']} steps"
+        if r["ok"] and r.get("runs", 1) > 1:
+            lo, hi = r["ms_range"]
+            note += f"; median of {r['runs']} runs ({fmt_num(lo)}–{fmt_num(hi)})"
         cells = [r["case"], str(r.get("rods", ROD_COUNT[r["case"]])),
                  fmt_num(h * 1e3) if h else "–", str(r["threads"]),
                  fmt_num(r.get("ms_per_step_median")) if r["ok"] else "–",
@@ -227,6 +236,25 @@ def table(rows):
                  fmt_num(r.get("peak_rss_mb"), 3), speedup, note]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
+
+
+def median_rows(rounds):
+    """Per case and thread count, the run of median time (its other fields with it) over the
+    rounds, with the range and the number of runs; a case that failed in any round is the first
+    such failure."""
+    out = []
+    for i, first in enumerate(rounds[0]):
+        runs = [r[i] for r in rounds]
+        failed = [r for r in runs if not r["ok"]]
+        if failed:
+            out.append(failed[0])
+            continue
+        runs.sort(key=lambda r: r["ms_per_step_median"])
+        row = dict(runs[(len(runs) - 1) // 2])  # the lower median for an even count
+        row["runs"] = len(runs)
+        row["ms_range"] = (runs[0]["ms_per_step_median"], runs[-1]["ms_per_step_median"])
+        out.append(row)
+    return out
 
 
 def fit_exponent(points):
@@ -239,9 +267,20 @@ def fit_exponent(points):
     return slope, math.exp(my - slope * mx)
 
 
-def scaling(rows, threads_list):
+def scaling(rows, threads_list, rounds=None):
     out = []
     for t in threads_list:
+        if rounds and len(rounds) > 1:  # each round's own fit, for the spread
+            fits = []
+            for rr in rounds:
+                ran = {r["case"]: r for r in rr if r["threads"] == t and r["ok"]}
+                pts = [(ROD_COUNT[c], ran[c]["ms_per_step_median"]) for c in SCALING_CASES
+                       if c in ran]
+                if len(pts) >= 3:
+                    fits.append(fit_exponent(pts)[0])
+            if fits:
+                out.append(f"Scaling, {t} thread(s), each round's fit: "
+                           + ", ".join(f"{f:.2f}" for f in fits))
         ran = {r["case"]: r for r in rows if r["threads"] == t and r["ok"]}
         pts = [(ROD_COUNT[c], ran[c]["ms_per_step_median"]) for c in SCALING_CASES if c in ran]
         if len(pts) >= 3:
@@ -276,15 +315,21 @@ def main():
           f"binary {args.binary}" + (f"; --set {' '.join(args.set)}" if args.set else ""))
     sys.stdout.flush()
 
-    rows = []
-    for case in args.cases:
-        for t in args.threads:
-            row = run_case(args, case, t, int(mem_limit_gb * 2**30))
-            rows.append(row)
-            status = (f"{fmt_num(row.get('ms_per_step_median'))} ms/step" if row["ok"]
-                      else row.get("message", "failed"))
-            print(f"  {case} threads={t}: {status} ({row['wall_seconds']} s)", file=sys.stderr,
-                  flush=True)
+    rounds = []
+    for k in range(args.repeat):
+        rows = []
+        for case in args.cases:
+            for t in args.threads:
+                row = run_case(args, case, t, int(mem_limit_gb * 2**30))
+                row["round"] = k + 1
+                rows.append(row)
+                status = (f"{fmt_num(row.get('ms_per_step_median'))} ms/step" if row["ok"]
+                          else row.get("message", "failed"))
+                tag = f" round {k + 1}/{args.repeat}" if args.repeat > 1 else ""
+                print(f"  {case} threads={t}{tag}: {status} ({row['wall_seconds']} s)",
+                      file=sys.stderr, flush=True)
+        rounds.append(rows)
+    rows = median_rows(rounds) if args.repeat > 1 else rounds[0]
     load_end = os.getloadavg()
 
     print(f"Load average at end: {' '.join(f'{l:.2f}' for l in load_end)}")
@@ -294,14 +339,15 @@ def main():
     print()
     print(table(rows))
     print()
-    for line in scaling(rows, args.threads):
+    for line in scaling(rows, args.threads, rounds):
         print(line)
 
     if args.json:
         with open(args.json, "w") as f:
             json.dump({"machine": info, "load_start": load_start, "load_end": load_end,
                        "timeout": args.timeout, "mem_limit_gb": mem_limit_gb, "set": args.set,
-                       "results": rows}, f, indent=2)
+                       "repeat": args.repeat,
+                       "results": [r for rr in rounds for r in rr]}, f, indent=2)
             f.write("\n")
     return 0  # failed and timed-out cases are rows of the table, not an error of the script
 
