@@ -208,15 +208,16 @@ Geometry TurnedRing(double angle) {
 
 // The near corrections reused across Updates (fluid/mobility_reuse.h on their values, at the
 // reuse tolerance 1e-4): on the ring 3R apart turning as Fig. 1 does at h = 1 ms (1.6e-3 rad per
-// Update), most Updates extrapolate (measured: 29 of 120 compute the blocks; the pattern of near
-// pairs between the helices changes 5 times, each change restarting the history from two
-// assemblies), and the products stay within the tolerance of the same
-// operator computing them at every Update (relative 2-norm; the near blocks carry the largest
-// part of each node's velocity, their error is measured and kept below 1e-4 relative in the
-// Frobenius norm: allowed 1.5 × it, as the dense 𝕄's reuse). Where the pattern of near pairs
-// changes (a helix moved next to another) and after ForgetHistory (a restart point), the next
-// Update computes them again: the products are then those of the operator without reuse, bit for
-// bit.
+// Update), most Updates extrapolate (measured: 9 of 120 compute the blocks; the pattern of near
+// pairs between the helices changes 5 times, and each change is taken into the history (REMAP):
+// the targets whose near segments changed get their blocks at the held geometries; before
+// REMAP each change restarted the history, and 29 of 120 computed them), and the products stay
+// within the tolerance of the same operator computing them at every Update (relative 2-norm;
+// the near blocks carry the largest part of each node's velocity, their error is measured and
+// kept below 1e-4 relative in the Frobenius norm: allowed 1.5 × it, as the dense 𝕄's reuse).
+// Where a helix jumps next to another (off the line the history extrapolates along: JUMPS) and
+// after ForgetHistory (a restart point), the next Update computes them again: the products are
+// then those of the operator without reuse, bit for bit.
 TEST(MatrixFreeMobility, NearCorrectionsAreReusedWithinTheTolerance) {
   MobilityOptions options;
   options.kind = MobilityKind::kMatrixFree;
@@ -238,10 +239,12 @@ TEST(MatrixFreeMobility, NearCorrectionsAreReusedWithinTheTolerance) {
     worst = std::max(worst, (u - u_fresh).norm() / u_fresh.norm());
   }
   const MobilityReuseStats stats = op->reuse_stats();
-  std::printf("  %ld of %ld Updates computed the near blocks; products within %.2e; largest "
-              "measured %.2e\n", stats.assemblies, stats.updates, worst, stats.largest_error);
+  std::printf("  %ld of %ld Updates computed the near blocks, %ld pattern changes remapped; "
+              "products within %.2e; largest measured %.2e\n",
+              stats.assemblies, stats.updates, stats.remaps, worst, stats.largest_error);
   EXPECT_EQ(stats.updates, 120);
-  EXPECT_LT(stats.assemblies, 120 / 3);
+  EXPECT_GE(stats.remaps, 3);
+  EXPECT_LT(stats.assemblies, 120 / 8);
   EXPECT_GT(worst, 0.0);
   EXPECT_LT(worst, 1.5e-4);
   EXPECT_LT(stats.largest_error, 1.5e-4);

@@ -426,5 +426,121 @@ TEST(MobilityReuseHalf, ExtrapolatesAsTheSinglePrecisionHistoryWithinTheToleranc
   EXPECT_LE(half.stats().assemblies, single.stats().assemblies + 2);
 }
 
+
+// REMAP: columns that join a history get the history they would have had. Reuse A holds every
+// column of 𝕄 twice from the start (interleaved: 2j and 2j + 1 are column j); reuse B holds 𝕄
+// twice as [𝕄, 𝕄] until update k, then is remapped to A's layout: even columns kept from its first
+// copy, odd ones kept from its second copy for odd j and assembled anew (at its held geometries)
+// for even j, so runs of kept and new columns alternate. Each copy appears twice in both, so A and
+// B measure the same errors and assemble at the same updates. Without half precision the passes
+// over the new columns are those A made over them: after the remap B gives A's matrices bit for
+// bit, at every history length (k = 1: one geometry held; 2: linear; 3 and more: quadratic, in
+// mid-interval). With D₁, D₂ in half precision the new columns' past D₁ was not rounded to half
+// as A's was (only the last, at the remap): their D₂ differs by that rounding, ≤ 2⁻¹¹ |D₁| per
+// entry, so the extrapolation by ≤ 2⁻¹¹ |α β s (s + 1)| |D₁| ≈ 1.5e-5 |𝕄| at most (s ≤ 2, α β =
+// 1/2 at equal intervals, |D₁| ≈ 1e-2 |𝕄| over an interval); measured 1.0e-6 of |𝕄|, allowed
+// 1e-5, a tenth of the reuse tolerance.
+void RemapAgainstHeldFromTheStart(bool half) {
+  FluidParams params;
+  const std::vector<Matrix3X> x0 = TurnedHelices(0.0);
+  MatX probe;
+  AssembleMobility(params, Rods(x0), &probe);
+  const Eigen::Index n = probe.cols();
+  auto geometry = [](const std::vector<Matrix3X>& x) {
+    VecX g(3 * (x[0].cols() + x[1].cols()));
+    g << x[0].reshaped(), x[1].reshaped();
+    return g;
+  };
+  auto exact = [&](const VecX& g) {
+    const Matrix3X all = g.reshaped(3, g.size() / 3);
+    const std::vector<Matrix3X> x = {all.leftCols(33), all.rightCols(33)};
+    MatX m;
+    AssembleMobility(params, Rods(x), &m);
+    return m;
+  };
+  const MobilityReuse::Assemble interleaved = [&](const VecX& g, MatX* out) {
+    const MatX m = exact(g);
+    out->resize(m.rows(), 2 * n);
+    for (Eigen::Index j = 0; j < n; ++j) out->col(2 * j) = m.col(j), out->col(2 * j + 1) = m.col(j);
+  };
+  const MobilityReuse::Assemble stacked = [&](const VecX& g, MatX* out) {
+    const MatX m = exact(g);
+    out->resize(m.rows(), 2 * n);
+    *out << m, m;
+  };
+  std::vector<int> old_column(static_cast<size_t>(2 * n));
+  std::vector<Eigen::Index> fresh;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    old_column[static_cast<size_t>(2 * j)] = static_cast<int>(j);
+    old_column[static_cast<size_t>(2 * j + 1)] = j % 2 == 1 ? static_cast<int>(n + j) : -1;
+    if (j % 2 == 0) fresh.push_back(j);
+  }
+  auto fresh_columns = [&](const VecX& g, MatX* out) {
+    const MatX m = exact(g);
+    out->resize(m.rows(), static_cast<Eigen::Index>(fresh.size()));
+    for (std::size_t i = 0; i < fresh.size(); ++i) out->col(static_cast<Eigen::Index>(i)) = m.col(fresh[i]);
+  };
+  const double step_angle = 1.6e-3;
+  double worst = 0.0;
+  for (const int k : {1, 2, 3, 8, 29}) {
+    MobilityReuse a(1e-4, half), b(1e-4, half);
+    MatX assembled_a, assembled_b;
+    Eigen::MatrixXf extrapolated_a, extrapolated_b;
+    for (int step = 0; step < 90; ++step) {
+      const VecX g = geometry(TurnedHelices(step * step_angle));
+      if (step == k) b.Remap(old_column, fresh_columns);
+      const bool assembled = a.Update(g, interleaved, &assembled_a, &extrapolated_a);
+      ASSERT_EQ(b.Update(g, step < k ? stacked : interleaved, &assembled_b, &extrapolated_b),
+                assembled)
+          << "k " << k << " update " << step;
+      if (assembled || step < k) continue;
+      const double difference =
+          (extrapolated_a - extrapolated_b).cast<double>().norm() / assembled_a.norm();
+      worst = std::max(worst, difference);
+      if (!half) {
+        ASSERT_EQ(difference, 0.0) << "k " << k << " update " << step;
+      }
+    }
+    EXPECT_EQ(b.stats().remaps, 1);
+    EXPECT_EQ(b.stats().assemblies, a.stats().assemblies) << "k " << k;
+    EXPECT_LT(a.stats().assemblies, 90 / 3) << "k " << k;  // it did extrapolate
+  }
+  std::printf("  half %d: remapped against held from the start, worst %.2e of |M|\n", half, worst);
+  EXPECT_LT(worst, 1e-5);
+}
+
+TEST(MobilityReuse, RemappedColumnsContinueAsIfHeldFromTheStart) {
+  RemapAgainstHeldFromTheStart(false);
+}
+
+TEST(MobilityReuseHalf, RemappedColumnsContinueAsIfHeldFromTheStart) {
+  if (!HasLuSolveHalfAvx512()) GTEST_SKIP() << "no AVX-512 half-precision kernels on this CPU";
+  RemapAgainstHeldFromTheStart(true);
+}
+
+// JUMPS: a geometry that does not continue the motion is assembled, whatever the interval: one
+// helix moved by 1 cm (across the line of the turn) or the turn taken 200 steps ahead (at least
+// 5 intervals of ≤ 40: past kMaxLinePosition), in the middle of an interval.
+TEST(MobilityReuse, GeometriesOffTheLineAreAssembled) {
+  FluidParams params;
+  MobilityOptions options;
+  options.reuse_tolerance = 1e-4;
+  for (const bool along : {false, true}) {
+    const auto op = MakeMobilityOperator(params, options);
+    const double step_angle = 1.6e-3;
+    for (int k = 0; k < 60; ++k) op->Update(Rods(TurnedHelices(k * step_angle)));
+    const MobilityReuseHistory kept = op->reuse_history();
+    ASSERT_LT(kept.since + 1, kept.interval);  // the next would be extrapolated
+    const long before = op->reuse_stats().assemblies;
+    std::vector<Matrix3X> x = TurnedHelices((along ? 260 : 60) * step_angle);
+    if (!along) x[1].row(1).array() += 0.01;
+    op->Update(Rods(x));
+    MatX exact;
+    AssembleMobility(params, Rods(x), &exact);
+    EXPECT_EQ(op->reuse_stats().assemblies, before + 1) << "along " << along;
+    EXPECT_EQ((*op->matrix() - exact).cwiseAbs().maxCoeff(), 0.0) << "along " << along;
+  }
+}
+
 }  // namespace
 }  // namespace stokesrods

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <numeric>
 
 #include <Eigen/Geometry>
 
@@ -184,7 +185,7 @@ class MatrixFreeRssMobility final : public MobilityOperator {
   void Update(const std::vector<HydroRod>& rods) override;
   void ForgetHistory() override {
     choose_split_ = true;
-    near_reuse_.Forget();
+    ForgetNearHistory();
   }
   MobilityReuseStats reuse_stats() const override { return near_reuse_.stats(); }
   void Apply(const VecX& force, VecX* velocity) const override;
@@ -211,8 +212,23 @@ class MatrixFreeRssMobility final : public MobilityOperator {
   void BuildSplit(bool reuse = true);
   // near_ at the nodes: computed, or extrapolated by near_reuse_ while the pattern holds.
   void UpdateNearBlocks();
-  // Which nodes each target's near blocks take (NearBlocks' start and source, no values).
+  // Which nodes each target's near blocks take (NearBlocks' start and source, no values), and
+  // its near segments into pattern_segments_.
   void FindNearPattern(const Matrix3X& targets, NearBlocks* pattern) const;
+  // The near blocks of the targets `which` (nodes) with the near segments `segments` (per
+  // node), all at the node positions `at` (3 × M): the blocks near_reuse_'s history holds for
+  // a geometry of its own (REMAP in fluid/mobility_reuse.h), or at the nodes.
+  void NearBlocksAt(const Matrix3X& at, const std::vector<int>& which,
+                    const std::vector<std::vector<int>>& segments,
+                    std::vector<std::vector<std::pair<int, Mat3>>>* blocks) const;
+  // The near pattern changed to `pattern` (segments in pattern_segments_): near_reuse_ keeps
+  // the blocks of the targets whose near segments are those of near_segments_, and assembles
+  // the others' at its held geometries.
+  void RemapNearHistory(const NearBlocks& pattern);
+  void ForgetNearHistory() {
+    near_reuse_.Forget();
+    near_segments_.clear();
+  }
   // The near segments of each target, to `visit(t, near segments, scratch)` (in parallel).
   template <typename Visit>
   void ForEachTargetsNearSegments(const Matrix3X& targets, const Visit& visit) const;
@@ -223,9 +239,10 @@ class MatrixFreeRssMobility final : public MobilityOperator {
     std::vector<double> table;
     std::vector<char> is_near;
   };
+  // (kernels and inverse_voronoi (1/Λ_j) of one geometry, the one p is taken from)
   void NearPairBlocks(const Vec3& p, const std::vector<int>& near,
-                      const std::vector<RssRowKernel>& kernels, NearRowScratch* scratch,
-                      std::vector<std::pair<int, Mat3>>* blocks) const;
+                      const std::vector<RssRowKernel>& kernels, const VecX& inverse_voronoi,
+                      NearRowScratch* scratch, std::vector<std::pair<int, Mat3>>* blocks) const;
   // Per segment its first node and ε; per rod its first segment (and the total last).
   void SegmentLists(std::vector<int>* first_node, VecX* eps,
                     std::vector<int>* rod_first_segment) const;
@@ -256,9 +273,12 @@ class MatrixFreeRssMobility final : public MobilityOperator {
   // extrapolates as the uninterrupted one.
   bool reuse_near_;
   MobilityReuse near_reuse_;
+  // The near segments of each target of near_ while near_reuse_ holds a history (else empty).
+  std::vector<std::vector<int>> near_segments_;
   // FindNearBlocks' blocks per target before they are packed (kept: their capacity is reused).
   mutable std::vector<std::vector<std::pair<int, Mat3>>> per_target_;
   mutable std::vector<std::vector<int>> pattern_nodes_;  // FindNearPattern's, likewise
+  mutable std::vector<std::vector<int>> pattern_segments_;
   mutable Matrix3X strengths_, far_velocity_, density_;
 };
 
@@ -308,7 +328,7 @@ void MatrixFreeRssMobility::ChooseSplitByCost() {
     split_ = best;
     BuildSplit(false);
   }
-  near_reuse_.Forget();
+  ForgetNearHistory();
   if (reuse_near_) UpdateNearBlocks();  // the chosen split's blocks start the reuse's history
 }
 
@@ -395,7 +415,8 @@ void MatrixFreeRssMobility::FindNearBlocks(const Matrix3X& targets, NearBlocks* 
   per_target_.resize(static_cast<size_t>(targets.cols()));
   ForEachTargetsNearSegments(targets, [&](int t, const std::vector<int>& near,
                                           NearRowScratch* scratch) {
-    NearPairBlocks(targets.col(t), near, kernels, scratch, &per_target_[static_cast<size_t>(t)]);
+    NearPairBlocks(targets.col(t), near, kernels, inverse_voronoi_, scratch,
+                   &per_target_[static_cast<size_t>(t)]);
   });
   PackNearBlocks(per_target_, single_far_, out);
 }
@@ -403,7 +424,9 @@ void MatrixFreeRssMobility::FindNearBlocks(const Matrix3X& targets, NearBlocks* 
 void MatrixFreeRssMobility::FindNearPattern(const Matrix3X& targets, NearBlocks* pattern) const {
   std::vector<std::vector<int>>& nodes = pattern_nodes_;  // kept: their capacity is reused
   nodes.resize(static_cast<size_t>(targets.cols()));
+  pattern_segments_.resize(static_cast<size_t>(targets.cols()));
   ForEachTargetsNearSegments(targets, [&](int t, const std::vector<int>& near, NearRowScratch*) {
+    pattern_segments_[static_cast<size_t>(t)] = near;
     // NearPairBlocks' nodes: node k of a rod takes a block when segment k or k − 1 is near.
     std::vector<int>& out = nodes[static_cast<size_t>(t)];
     out.clear();
@@ -421,20 +444,92 @@ void MatrixFreeRssMobility::FindNearPattern(const Matrix3X& targets, NearBlocks*
   }
 }
 
+void MatrixFreeRssMobility::NearBlocksAt(
+    const Matrix3X& at, const std::vector<int>& which,
+    const std::vector<std::vector<int>>& segments,
+    std::vector<std::vector<std::pair<int, Mat3>>>* blocks) const {
+  // The rods' nodes, kernels and 1/Λ_j at `at` (the kernels keep their nodes by reference).
+  std::vector<Matrix3X> rod_nodes(static_cast<size_t>(num_rods()));
+  std::vector<RssRowKernel> kernels;
+  VecX inverse_voronoi(at.cols());
+  for (int r = 0; r < num_rods(); ++r) {
+    const int first = node_offset(r), count = node_offset(r + 1) - first;
+    Matrix3X& x = rod_nodes[static_cast<size_t>(r)];
+    x = at.middleCols(first, count);
+    inverse_voronoi.segment(first, count) = VoronoiLengths(x).cwiseInverse();
+    kernels.emplace_back(x, params_.regularization * rods_[static_cast<size_t>(r)].radius,
+                         accuracy_, split_.gauss_points);
+  }
+  blocks->resize(static_cast<size_t>(at.cols()));
+  const int n = static_cast<int>(which.size());
+#pragma omp parallel
+  {
+    NearRowScratch scratch;
+#pragma omp for schedule(dynamic, 16)
+    for (int i = 0; i < n; ++i) {
+      const int t = which[static_cast<size_t>(i)];
+      NearPairBlocks(at.col(t), segments[static_cast<size_t>(t)], kernels, inverse_voronoi,
+                     &scratch, &(*blocks)[static_cast<size_t>(t)]);
+    }
+  }
+}
+
+void MatrixFreeRssMobility::RemapNearHistory(const NearBlocks& pattern) {
+  const int m = static_cast<int>(pattern.start.size()) - 1;
+  if (near_segments_.size() != static_cast<size_t>(m)) return ForgetNearHistory();
+  std::vector<int> old_column, changed;
+  old_column.reserve(pattern.size());
+  for (int t = 0; t < m; ++t) {
+    const auto tu = static_cast<size_t>(t);
+    const int begin = pattern.start[tu], end = pattern.start[tu + 1];
+    if (pattern_segments_[tu] == near_segments_[tu]) {  // the same blocks: their history
+      SR_ASSERT(near_.start[tu + 1] - near_.start[tu] == end - begin, "near blocks miscounted");
+      for (int k = 0; k < end - begin; ++k) old_column.push_back(near_.start[tu] + k);
+    } else {
+      old_column.insert(old_column.end(), static_cast<size_t>(end - begin), -1);
+      if (end > begin) changed.push_back(t);
+    }
+  }
+  std::vector<std::vector<std::pair<int, Mat3>>> blocks;
+  const auto assemble = [&](const VecX& at, MatX* columns) {
+    NearBlocksAt(at.reshaped(3, m), changed, pattern_segments_, &blocks);
+    Eigen::Index count = 0;
+    for (const int t : changed) count += static_cast<Eigen::Index>(blocks[static_cast<size_t>(t)].size());
+    columns->resize(9, count);
+    Eigen::Index j = 0;
+    for (const int t : changed) {
+      const auto& list = blocks[static_cast<size_t>(t)];
+      SR_ASSERT(static_cast<int>(list.size()) == pattern.start[static_cast<size_t>(t) + 1] -
+                                                     pattern.start[static_cast<size_t>(t)],
+                "the near pattern and its blocks disagree");
+      for (const auto& [node, block] : list)  // in single precision, as the assemblies
+        columns->col(j++) = block.cast<float>().reshaped().cast<double>();
+    }
+  };
+  near_reuse_.Remap(old_column, assemble);
+}
+
 void MatrixFreeRssMobility::UpdateNearBlocks() {
   if (!reuse_near_) return FindNearBlocks(nodes_, &near_);
   NearBlocks pattern;
   FindNearPattern(nodes_, &pattern);
-  if (pattern.start != near_.start || pattern.source != near_.source) near_reuse_.Forget();
+  if (pattern.start != near_.start || pattern.source != near_.source ||
+      pattern_segments_ != near_segments_)
+    RemapNearHistory(pattern);
+  near_segments_ = pattern_segments_;
   const auto count = static_cast<Eigen::Index>(pattern.size());
   const VecX x = nodes_.reshaped();
   MatX exact;
   Eigen::MatrixXf extrapolated;
   const auto assemble = [&](const VecX& /*at: the current nodes, no history is restored*/,
                             MatX* values) {
-    FindNearBlocks(nodes_, &near_);
+    // Of the pattern's near segments (not searched again), in single precision, as the far sum
+    // (reuse_near_ only there).
+    std::vector<int> all(static_cast<size_t>(nodes_.cols()));
+    std::iota(all.begin(), all.end(), 0);
+    NearBlocksAt(nodes_, all, pattern_segments_, &per_target_);
+    PackNearBlocks(per_target_, single_far_, &near_);
     SR_ASSERT(near_.source == pattern.source, "the near pattern changed within an Update");
-    // (in single precision, as the far sum: reuse_near_ only there)
     *values = Eigen::Map<const Eigen::MatrixXf>(near_.block_single.front().data(), 9, count)
                   .cast<double>();
   };
@@ -454,7 +549,7 @@ void MatrixFreeRssMobility::UpdateNearBlocks() {
 
 void MatrixFreeRssMobility::NearPairBlocks(const Vec3& p, const std::vector<int>& near,
                                            const std::vector<RssRowKernel>& kernels,
-                                           NearRowScratch* scratch,
+                                           const VecX& inverse_voronoi, NearRowScratch* scratch,
                                            std::vector<std::pair<int, Mat3>>* blocks) const {
   // The exact near pairs minus the far sum's rule, by rows of RssRowKernel over the range of a
   // rod's segments that are near p (vectorized; columns of segments in the range that are not
@@ -489,7 +584,7 @@ void MatrixFreeRssMobility::NearPairBlocks(const Vec3& p, const std::vector<int>
       const int node = node_offset(rod) + k;
       Mat3 block;
       block << e[0], e[1], e[2], e[1], e[3], e[4], e[2], e[4], e[5];
-      blocks->emplace_back(node, (scale * inverse_voronoi_(node)) * block);
+      blocks->emplace_back(node, (scale * inverse_voronoi(node)) * block);
     }
     i = end;
   }

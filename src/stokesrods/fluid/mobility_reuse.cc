@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "stokesrods/common/assert.h"
 #include "stokesrods/fluid/mobility_reuse_avx512.h"
 
 namespace stokesrods {
@@ -111,7 +112,7 @@ bool MobilityReuse::Update(const VecX& x, const Assemble& assemble, MatX* assemb
     }
   }
   const bool same_size = !geometries_.empty() && geometries_.back().size() == x.size();
-  if (geometries_.size() >= 2 && same_size && since_ + 1 < interval_) {
+  if (geometries_.size() >= 2 && same_size && since_ + 1 < interval_ && OnTheLine(x)) {
     ++since_;
     const double s = Position(x);
     extrapolated->resize(base_.rows(), base_.cols());
@@ -181,17 +182,7 @@ void MobilityReuse::Take(const VecX& x, const MatX& assembled, bool measure) {
                                              base_.data(), slope_.data(), curve_.data(), &norm2));
   // D₁, D₂ to half precision; slope_, curve_ then hold the values the half ones stand for, so
   // that the next measurement reads what the extrapolation used (PRECISION).
-  half_current_ = false;
-  if (half_ && pass.new_slope) {
-    slope_half_.resize(static_cast<std::size_t>(slope_.size()));
-    slope_scale_ = RoundToHalfAvx512(slope_.size(), slope_.data(), slope_half_.data());
-    half_current_ = slope_scale_ > 0.0f;
-    if (quadratic && half_current_) {
-      curve_half_.resize(static_cast<std::size_t>(curve_.size()));
-      curve_scale_ = RoundToHalfAvx512(curve_.size(), curve_.data(), curve_half_.data());
-      half_current_ = curve_scale_ > 0.0f;
-    }
-  }
+  half_current_ = half_ && pass.new_slope && RoundDifferencesToHalf(quadratic);
   if (measure) {
     ++stats_.measurements;
     const double error = miss / std::max(std::sqrt(norm2), 1e-300);
@@ -213,6 +204,85 @@ void MobilityReuse::Take(const VecX& x, const MatX& assembled, bool measure) {
   if (held == static_cast<std::size_t>(kMaxHeld)) geometries_.erase(geometries_.begin());
   geometries_.push_back(x);
   since_ = 0;
+}
+
+void MobilityReuse::Remap(const std::vector<int>& old_column, const AssembleColumns& assemble) {
+  if (restore_) return Forget();  // not assembled again yet: the restored history would not fit
+  if (tolerance_ <= 0.0 || geometries_.empty()) return;
+  const Eigen::Index rows = base_.rows();
+  const auto cols = static_cast<Eigen::Index>(old_column.size());
+  std::vector<Eigen::Index> fresh;  // the new columns
+  for (Eigen::Index j = 0; j < cols; ++j) {
+    SR_ASSERT(old_column[static_cast<size_t>(j)] < base_.cols(), "Remap: no such column");
+    if (old_column[static_cast<size_t>(j)] < 0) fresh.push_back(j);
+  }
+  const auto num_fresh = static_cast<Eigen::Index>(fresh.size());
+  // The new columns through the held geometries, as Take took each (REMAP).
+  Eigen::MatrixXf base(rows, num_fresh), slope(rows, num_fresh);
+  Eigen::MatrixXf curve = Eigen::MatrixXf::Zero(rows, num_fresh);
+  if (num_fresh > 0) {
+    MatX values;
+    for (std::size_t k = 0; k < geometries_.size(); ++k) {
+      assemble(geometries_[k], &values);
+      SR_ASSERT(values.rows() == rows && values.cols() == num_fresh,
+                "Remap: the new columns assembled have the wrong size");
+      TakePass pass;
+      pass.new_slope = k >= 1;
+      if (k >= 2) {
+        const VecX step = geometries_[k] - geometries_[k - 1];
+        const double length2 = step.squaredNorm();
+        const double s_a =
+            length2 > 0.0 ? (geometries_[k - 2] - geometries_[k]).dot(step) / length2 : 0.0;
+        if (std::abs(1.0 + s_a) >= 0.25 && s_a < -1.0) {
+          pass.new_curve = true;
+          pass.alpha = 1.0 / (-1.0 - s_a);
+          pass.beta = 1.0 / -s_a;
+        }
+      }
+      double norm2 = 0.0;
+      TakeAssembly(values.size(), values.data(), pass, base.data(), slope.data(), curve.data(),
+                   &norm2);
+    }
+    stats_.remapped_columns += num_fresh * static_cast<long>(geometries_.size());
+  }
+  const bool with_slope = geometries_.size() >= 2;
+  // By runs of columns kept in order (most of them) or new.
+  auto remap = [&](const Eigen::MatrixXf& old, const Eigen::MatrixXf& fresh_values) {
+    Eigen::MatrixXf out(rows, cols);
+    Eigen::Index next = 0;
+    for (Eigen::Index j = 0; j < cols;) {
+      const int from = old_column[static_cast<size_t>(j)];
+      Eigen::Index run = 1;
+      if (from >= 0) {
+        while (j + run < cols && old_column[static_cast<size_t>(j + run)] == from + run) ++run;
+        out.middleCols(j, run) = old.middleCols(from, run);
+      } else {
+        while (j + run < cols && old_column[static_cast<size_t>(j + run)] < 0) ++run;
+        out.middleCols(j, run) = fresh_values.middleCols(next, run);
+        next += run;
+      }
+      j += run;
+    }
+    return out;
+  };
+  base_ = remap(base_, base);
+  if (with_slope)
+    slope_ = remap(slope_, slope);
+  else
+    slope_.resize(rows, cols);  // written by the next Take
+  if (quadratic_) curve_ = remap(curve_, curve);
+  // D₁, D₂ to half precision again, at the scale of the remapped matrices (PRECISION).
+  if (half_current_) half_current_ = RoundDifferencesToHalf(quadratic_);
+  ++stats_.remaps;
+}
+
+bool MobilityReuse::RoundDifferencesToHalf(bool with_curve) {
+  slope_half_.resize(static_cast<std::size_t>(slope_.size()));
+  slope_scale_ = RoundToHalfAvx512(slope_.size(), slope_.data(), slope_half_.data());
+  if (slope_scale_ <= 0.0f || !with_curve) return slope_scale_ > 0.0f;
+  curve_half_.resize(static_cast<std::size_t>(curve_.size()));
+  curve_scale_ = RoundToHalfAvx512(curve_.size(), curve_.data(), curve_half_.data());
+  return curve_scale_ > 0.0f;
 }
 
 void MobilityReuse::Forget() {
@@ -240,6 +310,16 @@ MobilityReuseHistory MobilityReuse::history() const {
 void MobilityReuse::Restore(const MobilityReuseHistory& history) {
   Forget();
   if (tolerance_ > 0.0 && !history.geometries.empty()) restore_ = history;
+}
+
+bool MobilityReuse::OnTheLine(const VecX& x) const {
+  const std::size_t held = geometries_.size();
+  const VecX& last = geometries_[held - 1];
+  const double step2 = (last - geometries_[held - 2]).squaredNorm();
+  const double s = Position(x);
+  // |x − (x_c + s (x_c − x_b))|² = |x − x_c|² − s² |x_c − x_b|²
+  const double off2 = std::max(0.0, (x - last).squaredNorm() - s * s * step2);
+  return std::abs(s) <= kMaxLinePosition && off2 <= step2;
 }
 
 double MobilityReuse::Position(const VecX& x) const {

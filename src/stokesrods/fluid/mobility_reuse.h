@@ -35,6 +35,23 @@
 // steps from a history 8 steps apart miss by 9.5e-5 linearly and 4.0e-6 quadratically; 40 steps
 // by 3.3e-4 and 2.1e-5 (docs/performance.md).
 //
+// REMAP. Where the matrix's columns change from one Update to the next (a near pair of the
+// matrix-free operator comes or goes), the columns kept keep their history and each new column
+// gets the one it would have had: its values at the held geometries (at most kMaxHeld), taken
+// oldest first through the same passes (𝕄_c, D₁ against the rounded 𝕄_c, D₂ through s_a of the
+// same geometries). Only D₁, D₂'s rounding to half precision differs: the new columns' D₁ is
+// rounded at the scale of the whole matrix once, not at each of its past assemblies. The
+// interval and the error measured are the history's: the next assembly measures every column.
+// Before, a change of the pattern dropped the history, and 20–100 helices 4R apart, whose near
+// pairs change every few steps, assembled at 0.4–0.8 of the steps instead of 0.08.
+//
+// JUMPS. The extrapolation is used only for geometries that continue the motion it was
+// measured on: along the line no farther than kMaxLinePosition |x_c − x_b| from x_c (a steady
+// motion reaches s ≤ 2 + 1/k: the interval at most doubles), and off it by at most |x_c − x_b|
+// (a turn of θ per interval leaves the line by ~θ s² |x_c − x_b|). Any other geometry (a rod
+// moved by hand, a restored state, a jump of the near pattern's geometry) is assembled, and the
+// error measured there sets the interval as for a large step.
+//
 // RESTART. A checkpoint keeps the history without its matrices (MobilityReuseHistory: where its
 // assemblies were taken, the counters); Restore assembles 𝕄 there again, bit for bit the
 // matrices the uninterrupted run holds, so a run need not forget the history at its restart
@@ -70,6 +87,8 @@ struct MobilityReuseStats {
   long assemblies = 0;          ///< of which assembled
   double largest_error = 0.0;   ///< largest e measured (relative Frobenius)
   long measurements = 0;        ///< assemblies at which e was measured
+  long remaps = 0;              ///< column changes taken into the history (Remap)
+  long remapped_columns = 0;    ///< new columns assembled at the held geometries, per geometry
 };
 
 /// The reuse's history short of its matrices: what a checkpoint keeps (io/checkpoint.h).
@@ -94,6 +113,8 @@ class MobilityReuse {
   /// The most assemblies in a row that take 𝕄_c only, after the quadratic extrapolation missed
   /// for even two steps.
   static constexpr int kMaxSkip = 8;
+  /// The farthest along the line, in units of |x_c − x_b|, the history extrapolates (JUMPS).
+  static constexpr double kMaxLinePosition = 4.0;
 
   /// `half_differences`: D₁, D₂ in half precision where the CPU has the kernels (PRECISION).
   explicit MobilityReuse(double tolerance, bool half_differences = false);
@@ -103,6 +124,14 @@ class MobilityReuse {
   /// always assembles. After Restore it first assembles the restored history again.
   bool Update(const VecX& x, const Assemble& assemble, MatX* assembled,
               Eigen::MatrixXf* extrapolated);
+  /// The values of the columns new to a Remap (in their order) at the node positions x.
+  using AssembleColumns = std::function<void(const VecX& x, MatX* columns)>;
+  /// The matrix's columns change (the near pairs of the matrix-free operator): column j becomes
+  /// column old_column[j] of the history, or, where old_column[j] < 0, a new one. The new columns
+  /// are assembled at each geometry held, oldest first, and taken through the passes their
+  /// assemblies would have made (REMAP), so the history goes on instead of starting again.
+  /// Nothing to do without a history (the next Update assembles).
+  void Remap(const std::vector<int>& old_column, const AssembleColumns& assemble);
   /// Drops the history: the next Update assembles.
   void Forget();
   /// The history as a checkpoint keeps it.
@@ -118,6 +147,11 @@ class MobilityReuse {
  private:
   /// s(x) on the line through the last two geometries.
   double Position(const VecX& x) const;
+  /// x is one the history may extrapolate to (JUMPS): |s(x)| ≤ kMaxLinePosition and x within
+  /// |x_c − x_b| of the line. Needs two geometries held.
+  bool OnTheLine(const VecX& x) const;
+  /// D₁ (and D₂ `with_curve`) to half precision (PRECISION); false where one is not finite.
+  bool RoundDifferencesToHalf(bool with_curve);
   /// Takes the assembled 𝕄(x) into the history; measures the extrapolation's miss when `measure`.
   void Take(const VecX& x, const MatX& assembled, bool measure);
 
