@@ -212,9 +212,9 @@ class MatrixFreeRssMobility final : public MobilityOperator {
   void BuildSplit(bool reuse = true);
   // near_ at the nodes: computed, or extrapolated by near_reuse_ while the pattern holds.
   void UpdateNearBlocks();
-  // Which nodes each target's near blocks take (NearBlocks' start and source, no values), and
-  // its near segments into pattern_segments_.
-  void FindNearPattern(const Matrix3X& targets, NearBlocks* pattern) const;
+  // Which nodes each node's near blocks take (NearBlocks' start and source, no values), and its
+  // near segments into pattern_segments_ (by near_list_: kept across Updates).
+  void FindNearPattern(NearBlocks* pattern) const;
   // The near blocks of the targets `which` (nodes) with the near segments `segments` (per
   // node), all at the node positions `at` (3 × M): the blocks near_reuse_'s history holds for
   // a geometry of its own (REMAP in fluid/mobility_reuse.h), or at the nodes.
@@ -279,6 +279,7 @@ class MatrixFreeRssMobility final : public MobilityOperator {
   mutable std::vector<std::vector<std::pair<int, Mat3>>> per_target_;
   mutable std::vector<std::vector<int>> pattern_nodes_;  // FindNearPattern's, likewise
   mutable std::vector<std::vector<int>> pattern_segments_;
+  mutable NearSegmentList near_list_;  // the near segments of the nodes, kept across Updates
   mutable Matrix3X strengths_, far_velocity_, density_;
 };
 
@@ -381,29 +382,7 @@ void MatrixFreeRssMobility::ForEachTargetsNearSegments(const Matrix3X& targets,
   SegmentLists(&first_node, &eps, &rod_first_segment);
   NearSegmentSearch search;
   search.Build(nodes_, first_node, eps, rod_first_segment, split_.near_delta);
-  const int m = static_cast<int>(targets.cols());
-  // Targets by blocks of kTargetBlock consecutive columns (a rod's nodes: close together): the
-  // chunks near a block's bounding box are found once for the block, so that each target tests
-  // only those (a test per target and rod was O(targets × rods): 5 % of the step at 100 helices).
-  constexpr int kTargetBlock = 16;
-  const int num_blocks = (m + kTargetBlock - 1) / kTargetBlock;
-#pragma omp parallel
-  {
-    std::vector<int> near, block_chunks;
-    std::vector<unsigned char> flags;
-    NearRowScratch scratch;
-#pragma omp for schedule(dynamic, 1)
-    for (int tb = 0; tb < num_blocks; ++tb) {
-      const int t_begin = tb * kTargetBlock, t_end = std::min(m, t_begin + kTargetBlock);
-      Eigen::AlignedBox3d block_box;
-      for (int t = t_begin; t < t_end; ++t) block_box.extend(Vec3(targets.col(t)));
-      search.ChunksNear(block_box, &block_chunks);
-      for (int t = t_begin; t < t_end; ++t) {
-        search.SegmentsNear(targets.col(t), block_chunks, &flags, &near);
-        visit(t, near, &scratch);
-      }
-    }
-  }
+  search.ForEachTarget<NearRowScratch>(targets, visit);
 }
 
 void MatrixFreeRssMobility::FindNearBlocks(const Matrix3X& targets, NearBlocks* out) const {
@@ -421,12 +400,20 @@ void MatrixFreeRssMobility::FindNearBlocks(const Matrix3X& targets, NearBlocks* 
   PackNearBlocks(per_target_, single_far_, out);
 }
 
-void MatrixFreeRssMobility::FindNearPattern(const Matrix3X& targets, NearBlocks* pattern) const {
+void MatrixFreeRssMobility::FindNearPattern(NearBlocks* pattern) const {
+  const auto m = static_cast<int>(nodes_.cols());
   std::vector<std::vector<int>>& nodes = pattern_nodes_;  // kept: their capacity is reused
-  nodes.resize(static_cast<size_t>(targets.cols()));
-  pattern_segments_.resize(static_cast<size_t>(targets.cols()));
-  ForEachTargetsNearSegments(targets, [&](int t, const std::vector<int>& near, NearRowScratch*) {
-    pattern_segments_[static_cast<size_t>(t)] = near;
+  nodes.resize(static_cast<size_t>(m));
+  {
+    std::vector<int> first_node, rod_first_segment;
+    VecX eps;
+    SegmentLists(&first_node, &eps, &rod_first_segment);
+    near_list_.Find(nodes_, first_node, eps, rod_first_segment, split_.near_delta,
+                    &pattern_segments_);
+  }
+#pragma omp parallel for schedule(static)
+  for (int t = 0; t < m; ++t) {
+    const std::vector<int>& near = pattern_segments_[static_cast<size_t>(t)];
     // NearPairBlocks' nodes: node k of a rod takes a block when segment k or k − 1 is near.
     std::vector<int>& out = nodes[static_cast<size_t>(t)];
     out.clear();
@@ -435,7 +422,7 @@ void MatrixFreeRssMobility::FindNearPattern(const Matrix3X& targets, NearBlocks*
       if (out.empty() || out.back() != node) out.push_back(node);
       out.push_back(node + 1);
     }
-  });
+  }
   pattern->start.assign(1, 0);
   pattern->source.clear();
   for (const std::vector<int>& list : nodes) {
@@ -512,7 +499,7 @@ void MatrixFreeRssMobility::RemapNearHistory(const NearBlocks& pattern) {
 void MatrixFreeRssMobility::UpdateNearBlocks() {
   if (!reuse_near_) return FindNearBlocks(nodes_, &near_);
   NearBlocks pattern;
-  FindNearPattern(nodes_, &pattern);
+  FindNearPattern(&pattern);
   if (pattern.start != near_.start || pattern.source != near_.source ||
       pattern_segments_ != near_segments_)
     RemapNearHistory(pattern);
