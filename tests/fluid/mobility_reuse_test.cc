@@ -478,7 +478,8 @@ void RemapAgainstHeldFromTheStart(bool half) {
   auto fresh_columns = [&](const VecX& g, MatX* out) {
     const MatX m = exact(g);
     out->resize(m.rows(), static_cast<Eigen::Index>(fresh.size()));
-    for (std::size_t i = 0; i < fresh.size(); ++i) out->col(static_cast<Eigen::Index>(i)) = m.col(fresh[i]);
+    for (std::size_t i = 0; i < fresh.size(); ++i)
+      out->col(static_cast<Eigen::Index>(i)) = m.col(fresh[i]);
   };
   const double step_angle = 1.6e-3;
   double worst = 0.0;

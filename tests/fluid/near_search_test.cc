@@ -192,8 +192,9 @@ TEST(NearSegmentList, SearchesAgainWhenTheSegmentsChange) {
   ThreeHelices helices(0.02);
   NearSegmentList list;
   std::vector<std::vector<int>> near;
-  list.Find(helices.nodes, helices.first_node, helices.eps, helices.rod_first_segment, delta, &near);
-  list.Find(helices.nodes, helices.first_node, helices.eps, helices.rod_first_segment, delta, &near);
+  for (int k = 0; k < 2; ++k)
+    list.Find(helices.nodes, helices.first_node, helices.eps, helices.rod_first_segment, delta,
+              &near);
   EXPECT_EQ(list.searches(), 1);
   EXPECT_EQ(list.kept(), 1);
   list.Find(helices.nodes, helices.first_node, helices.eps, helices.rod_first_segment, 1.1 * delta,

@@ -481,7 +481,8 @@ void MatrixFreeRssMobility::RemapNearHistory(const NearBlocks& pattern) {
   const auto assemble = [&](const VecX& at, MatX* columns) {
     NearBlocksAt(at.reshaped(3, m), changed, pattern_segments_, &blocks);
     Eigen::Index count = 0;
-    for (const int t : changed) count += static_cast<Eigen::Index>(blocks[static_cast<size_t>(t)].size());
+    for (const int t : changed)
+      count += static_cast<Eigen::Index>(blocks[static_cast<size_t>(t)].size());
     columns->resize(9, count);
     Eigen::Index j = 0;
     for (const int t : changed) {

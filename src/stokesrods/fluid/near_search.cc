@@ -152,7 +152,8 @@ bool NearSegmentList::Holds(const Matrix3X& nodes, const std::vector<int>& first
     return false;
   // 2Δ ≤ δ ((1 + kSkin) |v₀| − |v|) for every segment (header); written so that a NaN
   // coordinate fails it and searches anew.
-  const double move = std::sqrt((nodes - searched_at_).colwise().squaredNorm().maxCoeff());
+  const double move =
+      std::sqrt((nodes - searched_at_).colwise().squaredNorm().maxCoeff<Eigen::PropagateNaN>());
   double room = std::numeric_limits<double>::infinity();
   for (std::size_t s = 0; s < first_node.size(); ++s) {
     const int a = first_node[s];
