@@ -239,6 +239,11 @@ class MatrixFreeRssMobility final : public MobilityOperator {
     std::vector<double> table;
     std::vector<char> is_near;
   };
+  // Rod r's rows of exact closed forms minus the far rule, at its nodes x (kept by reference).
+  RssRowKernel RowKernel(int r, const Matrix3X& x) const {
+    return RssRowKernel(x, params_.regularization * rods_[static_cast<size_t>(r)].radius,
+                        accuracy_, split_.gauss_points);
+  }
   // (kernels and inverse_voronoi (1/Λ_j) of one geometry, the one p is taken from)
   void NearPairBlocks(const Vec3& p, const std::vector<int>& near,
                       const std::vector<RssRowKernel>& kernels, const VecX& inverse_voronoi,
@@ -388,9 +393,7 @@ void MatrixFreeRssMobility::ForEachTargetsNearSegments(const Matrix3X& targets,
 void MatrixFreeRssMobility::FindNearBlocks(const Matrix3X& targets, NearBlocks* out) const {
   std::vector<RssRowKernel> kernels;
   for (int r = 0; r < num_rods(); ++r)
-    kernels.emplace_back(*rods_[static_cast<size_t>(r)].x,
-                         params_.regularization * rods_[static_cast<size_t>(r)].radius,
-                         accuracy_, split_.gauss_points);
+    kernels.push_back(RowKernel(r, *rods_[static_cast<size_t>(r)].x));
   per_target_.resize(static_cast<size_t>(targets.cols()));
   ForEachTargetsNearSegments(targets, [&](int t, const std::vector<int>& near,
                                           NearRowScratch* scratch) {
@@ -444,8 +447,7 @@ void MatrixFreeRssMobility::NearBlocksAt(
     Matrix3X& x = rod_nodes[static_cast<size_t>(r)];
     x = at.middleCols(first, count);
     inverse_voronoi.segment(first, count) = VoronoiLengths(x).cwiseInverse();
-    kernels.emplace_back(x, params_.regularization * rods_[static_cast<size_t>(r)].radius,
-                         accuracy_, split_.gauss_points);
+    kernels.push_back(RowKernel(r, x));
   }
   blocks->resize(static_cast<size_t>(at.cols()));
   const int n = static_cast<int>(which.size());
@@ -501,10 +503,9 @@ void MatrixFreeRssMobility::UpdateNearBlocks() {
   if (!reuse_near_) return FindNearBlocks(nodes_, &near_);
   NearBlocks pattern;
   FindNearPattern(&pattern);
-  if (pattern.start != near_.start || pattern.source != near_.source ||
-      pattern_segments_ != near_segments_)
-    RemapNearHistory(pattern);
-  near_segments_ = pattern_segments_;
+  // (the node pattern follows from the segments: comparing those suffices)
+  if (pattern_segments_ != near_segments_) RemapNearHistory(pattern);
+  near_segments_.swap(pattern_segments_);  // the old lists' capacity serves the next search
   const auto count = static_cast<Eigen::Index>(pattern.size());
   const VecX x = nodes_.reshaped();
   MatX exact;
@@ -515,7 +516,7 @@ void MatrixFreeRssMobility::UpdateNearBlocks() {
     // (reuse_near_ only there).
     std::vector<int> all(static_cast<size_t>(nodes_.cols()));
     std::iota(all.begin(), all.end(), 0);
-    NearBlocksAt(nodes_, all, pattern_segments_, &per_target_);
+    NearBlocksAt(nodes_, all, near_segments_, &per_target_);
     PackNearBlocks(per_target_, single_far_, &near_);
     SR_ASSERT(near_.source == pattern.source, "the near pattern changed within an Update");
     *values = Eigen::Map<const Eigen::MatrixXf>(near_.block_single.front().data(), 9, count)

@@ -80,6 +80,19 @@ double TakeAssembly(Eigen::Index n, const double* exact, const TakePass& p, floa
   return sum;
 }
 
+// The quadratic's D₂ through x, the last geometry and the one before (`before`): s_a of `before`
+// on the new line (last → x); sets pass's curve (and returns true) where it is used (header).
+bool SetCurvePass(const VecX& before, const VecX& last, const VecX& x, TakePass* pass) {
+  const VecX step = x - last;
+  const double length2 = step.squaredNorm();
+  const double s_a = length2 > 0.0 ? (before - x).dot(step) / length2 : 0.0;
+  if (std::abs(1.0 + s_a) < 0.25 || s_a >= -1.0) return false;
+  pass->new_curve = true;
+  pass->alpha = 1.0 / (-1.0 - s_a);
+  pass->beta = 1.0 / -s_a;
+  return true;
+}
+
 }  // namespace
 
 MobilityReuse::MobilityReuse(double tolerance, bool half_differences)
@@ -112,9 +125,9 @@ bool MobilityReuse::Update(const VecX& x, const Assemble& assemble, MatX* assemb
     }
   }
   const bool same_size = !geometries_.empty() && geometries_.back().size() == x.size();
-  if (geometries_.size() >= 2 && same_size && since_ + 1 < interval_ && OnTheLine(x)) {
+  double s = 0.0;
+  if (geometries_.size() >= 2 && same_size && since_ + 1 < interval_ && OnTheLine(x, &s)) {
     ++since_;
-    const double s = Position(x);
     extrapolated->resize(base_.rows(), base_.cols());
     if (!half_current_) {
       Extrapolate(base_.size(), base_.data(), static_cast<float>(s), slope_.data(),
@@ -162,21 +175,9 @@ void MobilityReuse::Take(const VecX& x, const MatX& assembled, bool measure) {
     pass.use_curve = quadratic_;
   }
   pass.new_slope = held >= 1;
-  // The quadratic's D₂ through the new geometry, the last and the one before: s_a of the one
-  // before on the new line (x_last → x).
-  bool quadratic = false;
-  if (held >= 2) {
-    const VecX step = x - geometries_[held - 1];
-    const double length2 = step.squaredNorm();
-    const double s_a = length2 > 0.0 ? (geometries_[held - 2] - x).dot(step) / length2 : 0.0;
-    quadratic = std::abs(1.0 + s_a) >= 0.25 && s_a < -1.0;
-    if (quadratic) {
-      pass.new_curve = true;
-      pass.alpha = 1.0 / (-1.0 - s_a);
-      pass.beta = 1.0 / -s_a;
-      curve_.resize(assembled.rows(), assembled.cols());
-    }
-  }
+  const bool quadratic =
+      held >= 2 && SetCurvePass(geometries_[held - 2], geometries_[held - 1], x, &pass);
+  if (quadratic) curve_.resize(assembled.rows(), assembled.cols());
   double norm2 = 0.0;
   const double miss = std::sqrt(TakeAssembly(assembled.size(), assembled.data(), pass,
                                              base_.data(), slope_.data(), curve_.data(), &norm2));
@@ -211,12 +212,11 @@ void MobilityReuse::Remap(const std::vector<int>& old_column, const AssembleColu
   if (tolerance_ <= 0.0 || geometries_.empty()) return;
   const Eigen::Index rows = base_.rows();
   const auto cols = static_cast<Eigen::Index>(old_column.size());
-  std::vector<Eigen::Index> fresh;  // the new columns
-  for (Eigen::Index j = 0; j < cols; ++j) {
-    SR_ASSERT(old_column[static_cast<size_t>(j)] < base_.cols(), "Remap: no such column");
-    if (old_column[static_cast<size_t>(j)] < 0) fresh.push_back(j);
+  Eigen::Index num_fresh = 0;  // the new columns
+  for (const int from : old_column) {
+    SR_ASSERT(from < base_.cols(), "Remap: no such column");
+    num_fresh += from < 0;
   }
-  const auto num_fresh = static_cast<Eigen::Index>(fresh.size());
   // The new columns through the held geometries, as Take took each (REMAP).
   Eigen::MatrixXf base(rows, num_fresh), slope(rows, num_fresh);
   Eigen::MatrixXf curve = Eigen::MatrixXf::Zero(rows, num_fresh);
@@ -228,22 +228,11 @@ void MobilityReuse::Remap(const std::vector<int>& old_column, const AssembleColu
                 "Remap: the new columns assembled have the wrong size");
       TakePass pass;
       pass.new_slope = k >= 1;
-      if (k >= 2) {
-        const VecX step = geometries_[k] - geometries_[k - 1];
-        const double length2 = step.squaredNorm();
-        const double s_a =
-            length2 > 0.0 ? (geometries_[k - 2] - geometries_[k]).dot(step) / length2 : 0.0;
-        if (std::abs(1.0 + s_a) >= 0.25 && s_a < -1.0) {
-          pass.new_curve = true;
-          pass.alpha = 1.0 / (-1.0 - s_a);
-          pass.beta = 1.0 / -s_a;
-        }
-      }
+      if (k >= 2) SetCurvePass(geometries_[k - 2], geometries_[k - 1], geometries_[k], &pass);
       double norm2 = 0.0;
       TakeAssembly(values.size(), values.data(), pass, base.data(), slope.data(), curve.data(),
                    &norm2);
     }
-    stats_.remapped_columns += num_fresh * static_cast<long>(geometries_.size());
   }
   const bool with_slope = geometries_.size() >= 2;
   // By runs of columns kept in order (most of them) or new.
@@ -312,14 +301,15 @@ void MobilityReuse::Restore(const MobilityReuseHistory& history) {
   if (tolerance_ > 0.0 && !history.geometries.empty()) restore_ = history;
 }
 
-bool MobilityReuse::OnTheLine(const VecX& x) const {
+bool MobilityReuse::OnTheLine(const VecX& x, double* s) const {
   const std::size_t held = geometries_.size();
   const VecX& last = geometries_[held - 1];
-  const double step2 = (last - geometries_[held - 2]).squaredNorm();
-  const double s = Position(x);
+  const VecX step = last - geometries_[held - 2];
+  const double step2 = step.squaredNorm();
+  *s = step2 > 0.0 ? (x - last).dot(step) / step2 : 0.0;  // Position(x)
   // |x − (x_c + s (x_c − x_b))|² = |x − x_c|² − s² |x_c − x_b|²
-  const double off2 = std::max(0.0, (x - last).squaredNorm() - s * s * step2);
-  return std::abs(s) <= kMaxLinePosition && off2 <= step2;
+  const double off2 = std::max(0.0, (x - last).squaredNorm() - *s * *s * step2);
+  return std::abs(*s) <= kMaxLinePosition && off2 <= step2;
 }
 
 double MobilityReuse::Position(const VecX& x) const {

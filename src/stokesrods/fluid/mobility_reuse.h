@@ -88,7 +88,6 @@ struct MobilityReuseStats {
   double largest_error = 0.0;   ///< largest e measured (relative Frobenius)
   long measurements = 0;        ///< assemblies at which e was measured
   long remaps = 0;              ///< column changes taken into the history (Remap)
-  long remapped_columns = 0;    ///< new columns assembled at the held geometries, per geometry
 };
 
 /// The reuse's history short of its matrices: what a checkpoint keeps (io/checkpoint.h).
@@ -148,8 +147,8 @@ class MobilityReuse {
   /// s(x) on the line through the last two geometries.
   double Position(const VecX& x) const;
   /// x is one the history may extrapolate to (JUMPS): |s(x)| ≤ kMaxLinePosition and x within
-  /// |x_c − x_b| of the line. Needs two geometries held.
-  bool OnTheLine(const VecX& x) const;
+  /// |x_c − x_b| of the line; s = s(x) either way. Needs two geometries held.
+  bool OnTheLine(const VecX& x, double* s) const;
   /// D₁ (and D₂ `with_curve`) to half precision (PRECISION); false where one is not finite.
   bool RoundDifferencesToHalf(bool with_curve);
   /// Takes the assembled 𝕄(x) into the history; measures the extrapolation's miss when `measure`.

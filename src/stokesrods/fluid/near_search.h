@@ -103,8 +103,6 @@ class NearSegmentList {
   void Find(const Matrix3X& nodes, const std::vector<int>& first_node, const VecX& eps,
             const std::vector<int>& rod_first_segment, double delta,
             std::vector<std::vector<int>>* near);
-  /// Searches anew at the next Find.
-  void Clear() { candidates_.clear(); }
   /// Finds that searched (with or without the skin) and that tested the kept candidates.
   long searches() const { return searches_; }
   long kept() const { return kept_; }

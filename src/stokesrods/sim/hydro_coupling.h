@@ -23,9 +23,10 @@
 // rod's nodes at X₀ onto its nodes now (least squares about their centroids: Kabsch). The
 // blocks between rods turned about different axes, a wall's images, and what deforms, are left
 // to GMRES; rods clamped on a body, whose cell block holds the body's points, keep R_k = I.
-// Fig. 1 turns each helix 0.063 rad per step at h = 40 ms. It is rebuilt when the solves since the rebuild have
-// taken, beyond the first solve's count each, as many GMRES products as a rebuild costs
-// (kRebuildCostInProducts), or when one solve took more than twice the first's plus two.
+// Fig. 1 turns each helix 0.063 rad per step at h = 40 ms. It is rebuilt when the solves since
+// the rebuild have taken, beyond the first solve's count each, as many GMRES products as a
+// rebuild costs (kRebuildCostInProducts), or when one solve took more than twice the first's
+// plus two.
 // Measured (docs/performance.md, session 19): Fig. 1 over 75 s at h = 40 ms 27 196 → 14 798
 // products; ten helices at h = 10 ms 23.3 → 11.9 per step; unchanged at h = 1 ms from ten
 // helices up.
