@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <vector>
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -451,6 +452,85 @@ TEST(StokesletSumTest, SeveralTargetsAtOnceEqualEachTargetAlone) {
     EXPECT_LT((ranged.rightCols(n) - by_range.rightCols(n)).cwiseAbs().maxCoeff(),
               1e-6 * by_range.rightCols(n).cwiseAbs().maxCoeff());
   }
+}
+
+// Each instruction set's sums that this CPU can run (the dispatch takes the widest, so the
+// narrower ones are checked here directly), against the kernel summed pair by pair in double over
+// ranges of any length (whole and masked blocks): in double to round-off (1e-14 of Σ|S||g|), in
+// float within its rounding (1e-6); and n targets at once bit for bit each target alone.
+TEST(StokesletSumTest, EachInstructionSetsSumsMatchTheKernel) {
+  using Sum = void (*)(const SourceColumns&, const SourceRange*, int, int, const double* const*,
+                       double* const*);
+  using SumF = void (*)(const SourceColumnsF&, const SourceRange*, int, int, const float* const*,
+                        double* const*);
+  struct Isa {
+    const char* name;
+    bool present;
+    Sum sum;
+    SumF sum_f;
+  };
+  std::vector<Isa> isas;
+#if defined(__x86_64__)
+  isas.push_back({"AVX-512", HasPointSumAvx512(), PointSumTargetsAvx512, PointSumTargetsAvx512});
+  isas.push_back({"AVX2", HasPointSumAvx2(), PointSumTargetsAvx2, PointSumTargetsAvx2});
+#endif
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> unit(-0.1, 0.1);
+  MatX src = RandomSourceRows(61, &rng);
+  const Eigen::MatrixXf src_f = src.cast<float>();
+  const MatX rounded = src_f.cast<double>();
+  const std::vector<SourceRange> ranges = {{0, 61}, {3, 21}, {16, 32}, {40, 41}, {7, 7}, {45, 58}};
+  int checked = 0;
+  for (const Isa& isa : isas) {
+    if (!isa.present) continue;
+    ++checked;
+    for (const SourceRange& range : ranges) {
+      Matrix3X x(3, kPointSumTargets);
+      for (Eigen::Index k = 0; k < x.size(); ++k) x.data()[k] = unit(rng);
+      const Eigen::Matrix3Xf xf = x.cast<float>();
+      const double* xd[kPointSumTargets];
+      const float* xs[kPointSumTargets];
+      Matrix3X together = Matrix3X::Zero(3, 2 * kPointSumTargets), alone = together;
+      double* out[2][kPointSumTargets];
+      for (int k = 0; k < kPointSumTargets; ++k) {
+        xd[k] = x.col(k).data(), xs[k] = xf.col(k).data();
+        out[0][k] = together.col(k).data(), out[1][k] = together.col(kPointSumTargets + k).data();
+        double* one_d[1] = {alone.col(k).data()};
+        double* one_f[1] = {alone.col(kPointSumTargets + k).data()};
+        isa.sum(Columns(src), &range, 1, 1, &xd[k], one_d);
+        isa.sum_f(ColumnsF(src_f), &range, 1, 1, &xs[k], one_f);
+        Vec3 ref = Vec3::Zero(), ref_f = Vec3::Zero();
+        const Vec3 x_f = xf.col(k).cast<double>();
+        for (int s = range.begin; s < range.end; ++s) {
+          ref += RegularizedStokesletMatrix(x.col(k) - src.row(s).head<3>().transpose(),
+                                            std::sqrt(src(s, 3))) *
+                 src.row(s).tail<3>().transpose();
+          ref_f += RegularizedStokesletMatrix(x_f - rounded.row(s).head<3>().transpose(),
+                                              std::sqrt(rounded(s, 3))) *
+                   rounded.row(s).tail<3>().transpose();
+        }
+        const double scale = SumScale(src, range.begin, range.end, x.col(k));
+        const double scale_f = SumScale(rounded, range.begin, range.end, x_f);
+        for (int c = 0; c < 3; ++c) {
+          EXPECT_NEAR(alone(c, k), ref(c), 1e-14 * scale) << isa.name << " " << range.begin;
+          EXPECT_NEAR(alone(c, kPointSumTargets + k), ref_f(c), 1e-6 * scale_f)
+              << isa.name << " float " << range.begin;
+        }
+      }
+      for (int n = 1; n <= kPointSumTargets; ++n) {
+        together.setZero();
+        isa.sum(Columns(src), &range, 1, n, xd, out[0]);
+        isa.sum_f(ColumnsF(src_f), &range, 1, n, xs, out[1]);
+        for (int k = 0; k < n; ++k)
+          for (int c = 0; c < 3; ++c) {
+            EXPECT_EQ(together(c, k), alone(c, k)) << isa.name << " " << n << " targets";
+            EXPECT_EQ(together(c, kPointSumTargets + k), alone(c, kPointSumTargets + k))
+                << isa.name << " float, " << n << " targets";
+          }
+      }
+    }
+  }
+  if (checked == 0) GTEST_SKIP() << "neither AVX-512 nor AVX2 with FMA here: the portable loops";
 }
 
 // A run resumes bit for bit on another thread count (tests/reliability/kill_resume.py), so the

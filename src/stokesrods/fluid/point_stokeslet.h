@@ -1,16 +1,14 @@
 // The vectorized inner loop shared by the Stokeslet sums (stokeslet_sum.cc, fmm_sum.cc): sources
-// as the columns (x, y, z, ε², g_x, g_y, g_z) of an S × 7 matrix so that the loop over sources
-// vectorizes (AVX-512/AVX2 clones chosen at run time; stokeslet_sum.cc is built with
+// as the columns (x, y, z, ε², g_x, g_y, g_z) of an S × 7 matrix (point_sum_kernels.h) so that
+// the loop over sources vectorizes: on AVX-512, else AVX2 with FMA, by intrinsics
+// (point_sum_simd.h); elsewhere the portable loops (stokeslet_sum.cc, built with
 // -fno-math-errno). Internal to the fluid module.
 #pragma once
 
 #include "stokesrods/common/types.h"
+#include "stokesrods/fluid/point_sum_kernels.h"
 
 namespace stokesrods {
-
-struct SourceColumns {
-  const double *x, *y, *z, *e2, *gx, *gy, *gz;
-};
 
 /// The columns of an S × 7 source matrix.
 SourceColumns Columns(const MatX& src);
@@ -28,20 +26,8 @@ void AddPointSum(const SourceColumns& c, Eigen::Index begin, Eigen::Index end, c
 /// relative to an origin near the points, the sum over [begin, end) in float, added to w in
 /// double. Each term carries ~1e-7 of itself and the positions' rounding (~1e-7 of their extent
 /// from the origin) relative to the distance; for sums whose tolerance is ≥ 1e-4 (fmm_sum.cc).
-struct SourceColumnsF {
-  const float *x, *y, *z, *e2, *gx, *gy, *gz;
-};
 void AddPointSumSingle(const SourceColumnsF& c, Eigen::Index begin, Eigen::Index end,
                        const float* x, double* w);
-
-/// The width of the blocks of AddPointSumBlocks: every range it is given starts at a multiple of
-/// it and holds a multiple of it (padded with sources of zero strength, which add exactly zero).
-inline constexpr int kPointSumBlock = 16;
-
-/// A range [begin, end) of sources for AddPointSumBlocks.
-struct SourceRange {
-  int begin = 0, end = 0;
-};
 
 /// AddPointSumSingle over several ranges of sources at once, each a whole number of blocks of
 /// kPointSumBlock: no remainder loop, and one reduction of the lanes per target instead of one per
@@ -49,25 +35,23 @@ struct SourceRange {
 void AddPointSumBlocks(const SourceColumnsF& c, const SourceRange* ranges, int count,
                        const float* x, double* w);
 
-/// The most targets the *Targets sums below take at once.
-inline constexpr int kPointSumTargets = 4;
-
 /// The sums at n ≤ kPointSumTargets targets x[k] (adding to w[k]) over the same ranges of sources
-/// (any length: each masked at its end on AVX-512; without AVX-512 range by range): each block of
-/// sources is read once for all n (one target alone reads 7 vectors per 16 pairs, and its loop ran
-/// at less than half the rate of the multiply–add pipes on an Intel Xeon), and the lanes are
-/// reduced once per target for all ranges. Each target's sum is bit for bit the one-target sum.
+/// (any length: each masked at its end on AVX-512 and AVX2; in the portable loops range by range):
+/// each block of sources is read once for all n (one target alone reads 7 vectors per block, and
+/// its loop ran at less than half the rate of the multiply–add pipes on an Intel Xeon), and the
+/// lanes are reduced once per target for all ranges. Each target's sum is bit for bit the
+/// one-target sum.
 void AddPointSumRangesTargets(const SourceColumns& c, const SourceRange* ranges, int count, int n,
                               const double* const* x, double* const* w);
 void AddPointSumRangesTargets(const SourceColumnsF& c, const SourceRange* ranges, int count, int n,
                               const float* const* x, double* const* w);
 /// The same over ranges of whole blocks (AddPointSumBlocks' layout: its portable loop without
-/// AVX-512).
+/// AVX2).
 void AddPointSumBlocksTargets(const SourceColumnsF& c, const SourceRange* ranges, int count,
                               int n, const float* const* x, double* const* w);
 
 /// The compiler-vectorized loops behind AddPointSum, AddPointSumSingle and AddPointSumBlocks on
-/// CPUs without AVX-512 (there the sums run on intrinsics; the tests check both paths).
+/// CPUs without AVX2 and FMA (elsewhere the sums run on intrinsics; the tests check both paths).
 void PointSumPortable(const SourceColumns& c, Eigen::Index begin, Eigen::Index end,
                       const double* x, double* w);
 void PointSumSinglePortable(const SourceColumnsF& c, Eigen::Index begin, Eigen::Index end,

@@ -1,10 +1,11 @@
 // The direct sum of regularized Stokeslets and its vectorized inner loop (point_stokeslet.h). The
 // fast sum is the kernel-independent FMM of fmm_sum.cc.
 //
-// MEASURED (one thread): on an AMD EPYC (1280 sources × 650 targets, one target at a time) the
-// direct sum on AVX-512 intrinsics cost 0.46 ns per pair in double and 0.18 ns in single
-// precision (the compiler's vectorization of the portable loops, kept for CPUs without AVX-512:
-// 1.6 and 0.22 ns); on an Intel Xeon (Emerald Rapids; 2560 × 1300, BM_StokesletSumApply/20/4/0)
+// MEASURED (one thread): on an AMD EPYC with AVX-512 (1280 sources × 650 targets, one target at a
+// time) the direct sum on AVX-512 intrinsics (point_sum_simd.h) cost 0.46 ns per pair in double
+// and 0.18 ns in single precision (the compiler's vectorization of the portable loops, kept for
+// CPUs without AVX2: 1.6 and 0.22 ns); on one without (point_sum_avx2.cc) 1.5 and 0.59 ns on AVX2
+// intrinsics against 6.0 and 0.88 ns portable; on an Intel Xeon (Emerald Rapids; 2560 × 1300, BM_StokesletSumApply/20/4/0)
 // 0.52 ns in single precision one target at a time with the IEEE square root, 0.38 ns four at a
 // time with rsqrt14; in double 1.76 and 0.9 ns.
 #include "stokesrods/fluid/stokeslet_sum.h"
@@ -107,211 +108,78 @@ void PointSumBlocksPortable(const SourceColumnsF& c, const SourceRange* ranges, 
 
 namespace {
 
+// The sums on the widest vectors the CPU has (point_sum_simd.h): AVX-512, else AVX2 with FMA;
+// false where it has neither (the portable loops above then).
+template <class Columns, class T>
+bool AddSimdTargets(const Columns& c, const SourceRange* ranges, int count, int n,
+                    const T* const* x, double* const* w) {
 #if defined(__x86_64__)
-// The sums written with AVX-512 intrinsics: the arithmetic of the portable loops with fused
-// multiply–adds and the lanes kept in registers, and
-//   - 1/R³ as 1/R times 1/R², one multiplication fewer per pair than cubing 1/R;
-//   - 1/R by the 14-bit estimate rsqrt14 and Newton steps instead of the IEEE division and
-//     square root: one step in single precision (≈ 3 ulp), two in double (≈ 1 ulp). The IEEE
-//     operations bounded the loops on an Intel Xeon (20 helices, direct sum, one thread: float
-//     1.83 → 1.61 ms; double, at 1e-6, 5.9 → 3.1 ms with four targets at once), and cost
-//     nothing measurable in float on an AMD EPYC (session 12);
-//   - up to kPointSumTargets targets per pass over the sources (PointSumRanges512<K>).
-// GCC 12 vectorizes the portable loops into code 18 % slower in single precision and 3.5× slower
-// in double (measured, AMD EPYC, one thread, 1280 sources × 650 targets: 0.182 against 0.222 and
-// 0.456 against 1.61 ns per pair, before the targets were taken together). Any ranges: a block
-// that runs past a range's end is masked, its missing lanes read as a source at distance ≥ 1 of
-// zero strength (they add exactly zero).
-#define SR_AVX512 __attribute__((target("avx512f"), always_inline)) static inline
-
-// 16 floats or 8 doubles per vector.
-template <class T>
-struct Avx512;
-template <>
-struct Avx512<float> {
-  using V = __m512;
-  using Mask = __mmask16;
-  static constexpr int kLanes = 16;
-  SR_AVX512 V Set(float v) { return _mm512_set1_ps(v); }
-  SR_AVX512 V Load(Mask m, const float* p) { return _mm512_maskz_loadu_ps(m, p); }
-  SR_AVX512 V LoadOr(V fill, Mask m, const float* p) { return _mm512_mask_loadu_ps(fill, m, p); }
-  SR_AVX512 V Sub(V a, V b) { return _mm512_sub_ps(a, b); }
-  SR_AVX512 V Mul(V a, V b) { return _mm512_mul_ps(a, b); }
-  SR_AVX512 V Fma(V a, V b, V c) { return _mm512_fmadd_ps(a, b, c); }
-  SR_AVX512 V Inverse(V a) { return _mm512_div_ps(Set(1.0f), a); }
-  SR_AVX512 V Sqrt(V a) { return _mm512_sqrt_ps(a); }
-  // 1/√a by the 14-bit estimate and one Newton step, y (3 − a y²) / 2: relative error ≈ 3 ulp.
-  SR_AVX512 V InverseSqrt(V a) {
-    const V y = _mm512_rsqrt14_ps(a);
-    const V t = _mm512_fnmadd_ps(_mm512_mul_ps(a, y), y, Set(3.0f));
-    return _mm512_mul_ps(_mm512_mul_ps(Set(0.5f), y), t);
+  if (HasPointSumAvx512()) {
+    PointSumTargetsAvx512(c, ranges, count, n, x, w);
+    return true;
   }
-  SR_AVX512 double Sum(V a) { return _mm512_reduce_add_ps(a); }
-};
-template <>
-struct Avx512<double> {
-  using V = __m512d;
-  using Mask = __mmask8;
-  static constexpr int kLanes = 8;
-  SR_AVX512 V Set(double v) { return _mm512_set1_pd(v); }
-  SR_AVX512 V Load(Mask m, const double* p) { return _mm512_maskz_loadu_pd(m, p); }
-  SR_AVX512 V LoadOr(V fill, Mask m, const double* p) { return _mm512_mask_loadu_pd(fill, m, p); }
-  SR_AVX512 V Sub(V a, V b) { return _mm512_sub_pd(a, b); }
-  SR_AVX512 V Mul(V a, V b) { return _mm512_mul_pd(a, b); }
-  SR_AVX512 V Fma(V a, V b, V c) { return _mm512_fmadd_pd(a, b, c); }
-  SR_AVX512 V Inverse(V a) { return _mm512_div_pd(Set(1.0), a); }
-  SR_AVX512 V Sqrt(V a) { return _mm512_sqrt_pd(a); }
-  // 1/√a by the 14-bit estimate and two Newton steps y + y (1 − a y²)/2, the bracket by a fused
-  // multiply–add (≈ 1 ulp; the division and square root took ≈ 40 cycles per 8 lanes on an Intel
-  // Xeon, where the double sum ran at 1.7 ns per pair).
-  SR_AVX512 V InverseSqrt(V a) {
-    V y = _mm512_rsqrt14_pd(a);
-    for (int step = 0; step < 2; ++step) {
-      const V r = _mm512_fnmadd_pd(_mm512_mul_pd(a, y), y, Set(1.0));
-      y = _mm512_fmadd_pd(_mm512_mul_pd(y, r), Set(0.5), y);
-    }
-    return y;
+  if (HasPointSumAvx2()) {
+    PointSumTargetsAvx2(c, ranges, count, n, x, w);
+    return true;
   }
-  SR_AVX512 double Sum(V a) { return _mm512_reduce_add_pd(a); }
-};
-
-// (GCC 12's avx512fintrin.h warns on its own _mm512_undefined_ps, GCC bug 105593.)
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wuninitialized"
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
-// K targets at once over the same sources: each block of 16 sources is loaded once for all K
-// (one target alone reads 7 vectors per 16 pairs from L2, and its loop ran at less than half of
-// the multiply–add pipes' rate on an Intel Xeon: measured 27 cycles per block instead of ~12).
-// Each target's arithmetic, and the order of its sums, are those of K = 1.
-template <int K, class T, class Columns>
-__attribute__((target("avx512f")))
-void PointSumRanges512(const Columns& c, const SourceRange* ranges, int count,
-                       const T* const* x, double* const* w) {
-  using A = Avx512<T>;
-  using V = typename A::V;
-  const V one = A::Set(T(1));
-  V px[K], py[K], pz[K], wx[K], wy[K], wz[K];
-#pragma GCC unroll 8
-  for (int k = 0; k < K; ++k) {
-    px[k] = A::Set(x[k][0]), py[k] = A::Set(x[k][1]), pz[k] = A::Set(x[k][2]);
-    wx[k] = A::Set(T(0)), wy[k] = wx[k], wz[k] = wx[k];
-  }
-  for (int r = 0; r < count; ++r) {
-    for (int s = ranges[r].begin; s < ranges[r].end; s += A::kLanes) {
-      const int left = ranges[r].end - s;
-      const auto m = static_cast<typename A::Mask>(left >= A::kLanes ? ~0u : (1u << left) - 1u);
-      const V sx = A::Load(m, c.x + s), sy = A::Load(m, c.y + s), sz = A::Load(m, c.z + s);
-      const V e2 = A::LoadOr(one, m, c.e2 + s);
-      const V gx = A::Load(m, c.gx + s), gy = A::Load(m, c.gy + s), gz = A::Load(m, c.gz + s);
-#pragma GCC unroll 8
-      for (int k = 0; k < K; ++k) {
-        const V rx = A::Sub(px[k], sx), ry = A::Sub(py[k], sy), rz = A::Sub(pz[k], sz);
-        const V inv_r = A::InverseSqrt(A::Fma(rx, rx, A::Fma(ry, ry, A::Fma(rz, rz, e2))));
-        const V inv_r2 = A::Mul(inv_r, inv_r);
-        const V inv_r3 = A::Mul(inv_r, inv_r2);
-        const V a = A::Fma(e2, inv_r3, inv_r);
-        const V b = A::Mul(A::Fma(rx, gx, A::Fma(ry, gy, A::Mul(rz, gz))), inv_r3);
-        wx[k] = A::Fma(a, gx, A::Fma(b, rx, wx[k]));
-        wy[k] = A::Fma(a, gy, A::Fma(b, ry, wy[k]));
-        wz[k] = A::Fma(a, gz, A::Fma(b, rz, wz[k]));
-      }
-    }
-  }
-#pragma GCC unroll 8
-  for (int k = 0; k < K; ++k) {
-    w[k][0] += A::Sum(wx[k]);
-    w[k][1] += A::Sum(wy[k]);
-    w[k][2] += A::Sum(wz[k]);
-  }
-}
-
-template <class T, class Columns>
-__attribute__((target("avx512f")))
-void PointSumRanges512(const Columns& c, const SourceRange* ranges, int count, const T* x,
-                       double* w) {
-  PointSumRanges512<1>(c, ranges, count, &x, &w);
-}
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic pop
-#endif
-#undef SR_AVX512
-
-bool HasAvx512() {
-  static const bool has = __builtin_cpu_supports("avx512f");
-  return has;
-}
-#else
-constexpr bool HasAvx512() { return false; }
-template <class T, class Columns>
-void PointSumRanges512(const Columns&, const SourceRange*, int, const T*, double*) {}
-template <int K, class T, class Columns>
-void PointSumRanges512(const Columns&, const SourceRange*, int, const T* const*, double* const*) {}
-#endif
-
-// n ≤ kPointSumTargets targets over the same ranges, by the kernel for n at once.
-template <class T, class Columns>
-void PointSumTargets512(const Columns& c, const SourceRange* ranges, int count, int n,
-                        const T* const* x, double* const* w) {
-  switch (n) {
-    case 1: return PointSumRanges512<1>(c, ranges, count, x, w);
-    case 2: return PointSumRanges512<2>(c, ranges, count, x, w);
-    case 3: return PointSumRanges512<3>(c, ranges, count, x, w);
-    case 4: return PointSumRanges512<4>(c, ranges, count, x, w);
-    default: SR_ASSERT(false, "at most kPointSumTargets targets at once");
-  }
+  return false;
 }
 
 }  // namespace
 
+#if defined(__x86_64__)
+bool HasPointSumAvx512() {
+  static const bool has = __builtin_cpu_supports("avx512f");
+  return has;
+}
+bool HasPointSumAvx2() {
+  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  return has;
+}
+#else
+bool HasPointSumAvx512() { return false; }
+bool HasPointSumAvx2() { return false; }
+#endif
+
 void AddPointSumRangesTargets(const SourceColumns& c, const SourceRange* ranges, int count, int n,
                               const double* const* x, double* const* w) {
-  if (!HasAvx512()) {
-    for (int k = 0; k < n; ++k)
-      for (int r = 0; r < count; ++r) PointSumPortable(c, ranges[r].begin, ranges[r].end, x[k], w[k]);
-    return;
-  }
-  PointSumTargets512(c, ranges, count, n, x, w);
+  if (AddSimdTargets(c, ranges, count, n, x, w)) return;
+  for (int k = 0; k < n; ++k)
+    for (int r = 0; r < count; ++r) PointSumPortable(c, ranges[r].begin, ranges[r].end, x[k], w[k]);
 }
 
 void AddPointSumRangesTargets(const SourceColumnsF& c, const SourceRange* ranges, int count, int n,
                               const float* const* x, double* const* w) {
-  if (!HasAvx512()) {
-    for (int k = 0; k < n; ++k)
-      for (int r = 0; r < count; ++r)
-        PointSumSinglePortable(c, ranges[r].begin, ranges[r].end, x[k], w[k]);
-    return;
-  }
-  PointSumTargets512(c, ranges, count, n, x, w);
+  if (AddSimdTargets(c, ranges, count, n, x, w)) return;
+  for (int k = 0; k < n; ++k)
+    for (int r = 0; r < count; ++r)
+      PointSumSinglePortable(c, ranges[r].begin, ranges[r].end, x[k], w[k]);
 }
 
 void AddPointSumBlocksTargets(const SourceColumnsF& c, const SourceRange* ranges, int count,
                               int n, const float* const* x, double* const* w) {
-  if (!HasAvx512()) {
-    for (int k = 0; k < n; ++k) PointSumBlocksPortable(c, ranges, count, x[k], w[k]);
-    return;
-  }
-  PointSumTargets512(c, ranges, count, n, x, w);
+  if (AddSimdTargets(c, ranges, count, n, x, w)) return;
+  for (int k = 0; k < n; ++k) PointSumBlocksPortable(c, ranges, count, x[k], w[k]);
 }
 
 void AddPointSum(const SourceColumns& c, Eigen::Index begin, Eigen::Index end, const double* x,
                  double* w) {
-  if (!HasAvx512()) return PointSumPortable(c, begin, end, x, w);
   const SourceRange range{static_cast<int>(begin), static_cast<int>(end)};
-  PointSumRanges512(c, &range, 1, x, w);
+  if (AddSimdTargets(c, &range, 1, 1, &x, &w)) return;
+  PointSumPortable(c, begin, end, x, w);
 }
 
 void AddPointSumSingle(const SourceColumnsF& c, Eigen::Index begin, Eigen::Index end,
                        const float* x, double* w) {
-  if (!HasAvx512()) return PointSumSinglePortable(c, begin, end, x, w);
   const SourceRange range{static_cast<int>(begin), static_cast<int>(end)};
-  PointSumRanges512(c, &range, 1, x, w);
+  if (AddSimdTargets(c, &range, 1, 1, &x, &w)) return;
+  PointSumSinglePortable(c, begin, end, x, w);
 }
 
 void AddPointSumBlocks(const SourceColumnsF& c, const SourceRange* ranges, int count,
                        const float* x, double* w) {
-  if (HasAvx512()) return PointSumRanges512(c, ranges, count, x, w);
+  if (AddSimdTargets(c, ranges, count, 1, &x, &w)) return;
   PointSumBlocksPortable(c, ranges, count, x, w);
 }
 

@@ -25,10 +25,14 @@ void GemvRows(const Eigen::MatrixXd& a, Eigen::Index first, Eigen::Index rows, c
 void GemvRows(const Eigen::MatrixXf& a, Eigen::Index first, Eigen::Index rows, const float* x,
               float* y);
 
+/// The kernels of GemvRowsMixed: the widest vectors the CPU has (AVX-512, else AVX2 with FMA, else
+/// the plain loop), or for tests AVX2 even where AVX-512 is present, or the plain loop.
+enum class MixedGemvPath { kWidest, kAvx2, kPortable };
+
 /// y = A x for rows [first, first + rows) of a single-precision matrix, with x, y and the sums in
-/// double (gemv_mixed.cc: AVX-512 where the CPU has it; `portable` forces the plain loop, for
-/// tests). Each row's sum in one fixed order: independent of how rows are split over threads.
+/// double (gemv_mixed.cc). Each row's sum in one fixed order: independent of how rows are split
+/// over threads.
 void GemvRowsMixed(const Eigen::MatrixXf& a, Eigen::Index first, Eigen::Index rows, const double* x,
-                   double* y, bool portable = false);
+                   double* y, MixedGemvPath path = MixedGemvPath::kWidest);
 
 }  // namespace stokesrods
