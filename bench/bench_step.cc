@@ -11,7 +11,7 @@
 #include "common/helix_lattice.h"
 #include "stokesrods/contact/broad_phase.h"
 #include "stokesrods/contact/segment_distance.h"
-#include "stokesrods/fluid/mobility_reuse_avx512.h"
+#include "stokesrods/fluid/mobility_reuse_half.h"
 #include "stokesrods/io/build_model.h"
 #include "stokesrods/io/config.h"
 #include "stokesrods/sim/elastic_assembly.h"
@@ -168,7 +168,7 @@ BENCHMARK_CAPTURE(BM_MobilityProduct, single_double_sums, true)->Unit(benchmark:
 
 // One step's pass of the dense 𝕄's reuse on Fig. 1 (3M = 390, fluid/mobility_reuse.h): forming
 // 𝕄 = 𝕄_c + s D₁ + c D₂ with D₁, D₂ in single precision (the portable pass, here for AVX-512 F)
-// or in half precision (fluid/mobility_reuse_avx512.h).
+// or in half precision (fluid/mobility_reuse_half.h).
 __attribute__((target("avx512f"))) void ExtrapolateSingle(Eigen::Index n, const float* base,
                                                           float s, const float* slope, float c,
                                                           const float* curve, float* out) {
@@ -176,19 +176,19 @@ __attribute__((target("avx512f"))) void ExtrapolateSingle(Eigen::Index n, const 
   for (Eigen::Index i = 0; i < n; ++i) out[i] = base[i] + s * slope[i] + c * curve[i];
 }
 void BM_ReuseExtrapolate(benchmark::State& st, bool half) {
-  if (!HasLuSolveHalfAvx512()) return st.SkipWithError("no AVX-512 BW on this CPU");
+  if (!HasHalfDifferences()) return st.SkipWithError("neither AVX-512 BW nor F16C on this CPU");
   const int n = 390;
   const Eigen::MatrixXf base = Eigen::MatrixXf::Random(n, n);
   Eigen::MatrixXf slope = 1e-2f * Eigen::MatrixXf::Random(n, n);
   Eigen::MatrixXf curve = 1e-4f * Eigen::MatrixXf::Random(n, n);
   std::vector<std::uint16_t> slope_half(static_cast<std::size_t>(n) * n), curve_half(slope_half);
-  const float slope_scale = RoundToHalfAvx512(slope.size(), slope.data(), slope_half.data());
-  const float curve_scale = RoundToHalfAvx512(curve.size(), curve.data(), curve_half.data());
+  const float slope_scale = RoundToHalf(slope.size(), slope.data(), slope_half.data());
+  const float curve_scale = RoundToHalf(curve.size(), curve.data(), curve_half.data());
   Eigen::MatrixXf out(n, n);
   const float s = 0.37f, c = s * (s + 1.0f);
   for (auto _ : st) {
     if (half)
-      ExtrapolateHalfAvx512(out.size(), base.data(), s / slope_scale, slope_half.data(),
+      ExtrapolateHalf(out.size(), base.data(), s / slope_scale, slope_half.data(),
                             c / curve_scale, curve_half.data(), out.data());
     else
       ExtrapolateSingle(out.size(), base.data(), s, slope.data(), c, curve.data(), out.data());

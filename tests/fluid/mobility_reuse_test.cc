@@ -13,7 +13,7 @@
 #include <Eigen/Geometry>
 
 #include "stokesrods/fluid/mobility_operator.h"
-#include "stokesrods/fluid/mobility_reuse_avx512.h"
+#include "stokesrods/fluid/mobility_reuse_half.h"
 #include "stokesrods/fluid/rss.h"
 #include "stokesrods/rod/geometry.h"
 #include "stokesrods/solver/blas.h"
@@ -312,9 +312,9 @@ float DecodeHalf(std::uint16_t h) {
 // Entries over nine decades, with signs and zeros, n = 1 … 1000 (the kernels' masked tails): each
 // is replaced by what its half value stands for (the decoded half over the scale, exactly), within
 // half precision's rounding (2⁻¹¹ relative in its normal range, 2⁻²⁵ of the scale below it); the
-// scale is the power of two that puts the largest entry in [2¹⁴, 2¹⁵).
-TEST(MobilityReuseHalf, RoundsToWhatTheHalfValuesStandFor) {
-  if (!HasLuSolveHalfAvx512()) GTEST_SKIP() << "no AVX-512 BW on this CPU";
+// scale is the power of two that puts the largest entry in [2¹⁴, 2¹⁵). Both kernels (AVX-512 where
+// the CPU has it, and AVX2 with F16C), which give the same bits.
+void CheckRoundsToWhatTheHalfValuesStandFor(bool f16c) {
   std::mt19937 random(7);
   std::uniform_real_distribution<float> decade(-7.0f, 2.0f), unit(-1.0f, 1.0f);
   for (const int n : {1, 15, 16, 17, 1000}) {
@@ -323,7 +323,12 @@ TEST(MobilityReuseHalf, RoundsToWhatTheHalfValuesStandFor) {
     if (n > 2) d[1] = 0.0f;
     const std::vector<float> before = d;
     std::vector<std::uint16_t> half(d.size());
-    const float scale = RoundToHalfAvx512(n, d.data(), half.data());
+    const float scale = RoundToHalf(n, d.data(), half.data(), f16c);
+    std::vector<float> widest_d = before;
+    std::vector<std::uint16_t> widest(d.size());
+    EXPECT_EQ(RoundToHalf(n, widest_d.data(), widest.data()), scale);
+    EXPECT_EQ(widest, half) << "n " << n;
+    EXPECT_EQ(widest_d, d) << "n " << n;
     float largest = 0.0f;
     for (const float v : before) largest = std::max(largest, std::abs(v));
     EXPECT_EQ(std::ldexp(1.0f, std::ilogb(scale)), scale) << "a power of two";
@@ -338,36 +343,50 @@ TEST(MobilityReuseHalf, RoundsToWhatTheHalfValuesStandFor) {
   }
   std::vector<float> zeros(20, 0.0f);
   std::vector<std::uint16_t> half(20, 0xffff);
-  EXPECT_EQ(RoundToHalfAvx512(20, zeros.data(), half.data()), 1.0f);
+  EXPECT_EQ(RoundToHalf(20, zeros.data(), half.data(), f16c), 1.0f);
   EXPECT_EQ(half[19], 0);
   for (const float bad : {NAN, INFINITY}) {
-    std::vector<float> d(40, 1.0f);
-    d[33] = bad;
-    std::vector<std::uint16_t> untouched(40, 0x1234);
-    EXPECT_EQ(RoundToHalfAvx512(40, d.data(), untouched.data()), 0.0f);
-    EXPECT_EQ(untouched[0], 0x1234);
-    EXPECT_EQ(d[0], 1.0f);
+    for (const int where : {3, 33, 38}) {  // in a whole block of 8 or 16, or in the last entries
+      std::vector<float> d(39, 1.0f);
+      d[static_cast<std::size_t>(where)] = bad;
+      std::vector<std::uint16_t> untouched(39, 0x1234);
+      EXPECT_EQ(RoundToHalf(39, d.data(), untouched.data(), f16c), 0.0f) << where;
+      EXPECT_EQ(untouched[0], 0x1234);
+      EXPECT_EQ(d[0], 1.0f);
+    }
+  }
+}
+
+TEST(MobilityReuseHalf, RoundsToWhatTheHalfValuesStandFor) {
+  if (!HasHalfDifferences()) GTEST_SKIP() << "neither AVX-512 BW nor F16C on this CPU";
+  for (const bool f16c : {false, true}) {
+    SCOPED_TRACE(f16c ? "AVX2 with F16C" : "the widest kernel");
+    CheckRoundsToWhatTheHalfValuesStandFor(f16c);
   }
 }
 
 // The extrapolation from half-precision differences is base + a · slope + b · curve on the
 // decoded values, to single precision's rounding of the sum (with and without the curve; n with
-// masked tails).
+// masked tails), by both kernels.
 TEST(MobilityReuseHalf, ExtrapolatesTheDecodedDifferences) {
-  if (!HasLuSolveHalfAvx512()) GTEST_SKIP() << "no AVX-512 BW on this CPU";
+  if (!HasHalfDifferences()) GTEST_SKIP() << "neither AVX-512 BW nor F16C on this CPU";
   std::mt19937 random(11);
   std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
-  for (const int n : {5, 16, 390 * 390}) {
+  for (const int n : {5, 16, 21, 390 * 390}) {
     std::vector<float> base(static_cast<std::size_t>(n)), slope(base), curve(base), out(base);
     for (std::size_t i = 0; i < base.size(); ++i)
       base[i] = unit(random), slope[i] = 1e-2f * unit(random), curve[i] = 1e-4f * unit(random);
     std::vector<std::uint16_t> slope_half(base.size()), curve_half(base.size());
-    const float s1 = RoundToHalfAvx512(n, slope.data(), slope_half.data());
-    const float s2 = RoundToHalfAvx512(n, curve.data(), curve_half.data());
+    const float s1 = RoundToHalf(n, slope.data(), slope_half.data());
+    const float s2 = RoundToHalf(n, curve.data(), curve_half.data());
     for (const bool quadratic : {false, true}) {
       const float a = 0.37f, b = quadratic ? 0.37f * 1.37f : 0.0f;
-      ExtrapolateHalfAvx512(n, base.data(), a / s1, slope_half.data(), b / s2,
-                            quadratic ? curve_half.data() : nullptr, out.data());
+      ExtrapolateHalf(n, base.data(), a / s1, slope_half.data(), b / s2,
+                      quadratic ? curve_half.data() : nullptr, out.data());
+      std::vector<float> f16c(base.size());  // the AVX2 kernel: the same bits
+      ExtrapolateHalf(n, base.data(), a / s1, slope_half.data(), b / s2,
+                      quadratic ? curve_half.data() : nullptr, f16c.data(), true);
+      EXPECT_EQ(f16c, out) << "n " << n << " quadratic " << quadratic;
       double worst = 0.0;
       for (std::size_t i = 0; i < base.size(); ++i) {
         const double exact = static_cast<double>(base[i]) + static_cast<double>(a) * slope[i] +
@@ -386,7 +405,7 @@ TEST(MobilityReuseHalf, ExtrapolatesTheDecodedDifferences) {
 // the interval's change of 𝕄, ~1e-2: ≤ 1e-5 of 𝕄), both stay within the tolerance, and the
 // half one assembles about as often (its error measured on the values it uses).
 TEST(MobilityReuseHalf, ExtrapolatesAsTheSinglePrecisionHistoryWithinTheTolerance) {
-  if (!HasLuSolveHalfAvx512()) GTEST_SKIP() << "no AVX-512 BW on this CPU";
+  if (!HasHalfDifferences()) GTEST_SKIP() << "neither AVX-512 BW nor F16C on this CPU";
   const double tolerance = 1e-4;
   FluidParams params;
   MobilityReuse half(tolerance, true), single(tolerance, false);
@@ -515,7 +534,7 @@ TEST(MobilityReuse, RemappedColumnsContinueAsIfHeldFromTheStart) {
 }
 
 TEST(MobilityReuseHalf, RemappedColumnsContinueAsIfHeldFromTheStart) {
-  if (!HasLuSolveHalfAvx512()) GTEST_SKIP() << "no AVX-512 half-precision kernels on this CPU";
+  if (!HasHalfDifferences()) GTEST_SKIP() << "neither AVX-512 BW nor F16C on this CPU";
   RemapAgainstHeldFromTheStart(true);
 }
 

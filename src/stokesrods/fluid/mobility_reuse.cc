@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "stokesrods/common/assert.h"
-#include "stokesrods/fluid/mobility_reuse_avx512.h"
+#include "stokesrods/fluid/mobility_reuse_half.h"
 
 namespace stokesrods {
 namespace {
@@ -96,7 +96,7 @@ bool SetCurvePass(const VecX& before, const VecX& last, const VecX& x, TakePass*
 }  // namespace
 
 MobilityReuse::MobilityReuse(double tolerance, bool half_differences)
-    : tolerance_(tolerance), half_(half_differences && HasLuSolveHalfAvx512()) {}
+    : tolerance_(tolerance), half_(half_differences && HasHalfDifferences()) {}
 
 bool MobilityReuse::Update(const VecX& x, const Assemble& assemble, MatX* assembled,
                            Eigen::MatrixXf* extrapolated) {
@@ -142,7 +142,7 @@ bool MobilityReuse::Update(const VecX& x, const Assemble& assemble, MatX* assemb
 #pragma omp parallel for schedule(static) if (n >= kParallelEntries)
     for (int part = 0; part < 2; ++part) {
       const Eigen::Index first = part * half, count = part == 0 ? half : n - half;
-      ExtrapolateHalfAvx512(count, base_.data() + first, a, slope_half_.data() + first, b,
+      ExtrapolateHalf(count, base_.data() + first, a, slope_half_.data() + first, b,
                             quadratic_ ? curve_half_.data() + first : nullptr,
                             extrapolated->data() + first);
     }
@@ -267,10 +267,10 @@ void MobilityReuse::Remap(const std::vector<int>& old_column, const AssembleColu
 
 bool MobilityReuse::RoundDifferencesToHalf(bool with_curve) {
   slope_half_.resize(static_cast<std::size_t>(slope_.size()));
-  slope_scale_ = RoundToHalfAvx512(slope_.size(), slope_.data(), slope_half_.data());
+  slope_scale_ = RoundToHalf(slope_.size(), slope_.data(), slope_half_.data());
   if (slope_scale_ <= 0.0f || !with_curve) return slope_scale_ > 0.0f;
   curve_half_.resize(static_cast<std::size_t>(curve_.size()));
-  curve_scale_ = RoundToHalfAvx512(curve_.size(), curve_.data(), curve_half_.data());
+  curve_scale_ = RoundToHalf(curve_.size(), curve_.data(), curve_half_.data());
   return curve_scale_ > 0.0f;
 }
 

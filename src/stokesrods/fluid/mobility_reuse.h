@@ -65,7 +65,7 @@
 // GemvRowsMixed). From a tolerance of kSinglePrecisionTolerance (1e-4) on, the dense operator's
 // products take the assembled 𝕄 rounded too (last_assembly_single(), the history's 𝕄_c): at a
 // large step, where 𝕄 is assembled at every step, each product then streams half the bytes.
-// With `half_differences` (that tolerance, and a CPU with AVX-512 BW: mobility_reuse_avx512.h)
+// With `half_differences` (that tolerance, and a CPU with AVX-512 BW or F16C: mobility_reuse_half.h)
 // D₁ and D₂ are also rounded to IEEE half precision, each scaled by a power of two, and the
 // single-precision D₁, D₂ the measurement reads are replaced by the values the half ones stand
 // for: the extrapolation streams 𝕄_c and half of D₁, D₂'s bytes, and e still measures exactly
