@@ -167,11 +167,11 @@ BENCHMARK_CAPTURE(BM_MobilityProduct, double, false)->Unit(benchmark::kMicroseco
 BENCHMARK_CAPTURE(BM_MobilityProduct, single_double_sums, true)->Unit(benchmark::kMicrosecond);
 
 // One step's pass of the dense 𝕄's reuse on Fig. 1 (3M = 390, fluid/mobility_reuse.h): forming
-// 𝕄 = 𝕄_c + s D₁ + c D₂ with D₁, D₂ in single precision (the portable pass, here for AVX-512 F)
-// or in half precision (fluid/mobility_reuse_half.h).
-__attribute__((target("avx512f"))) void ExtrapolateSingle(Eigen::Index n, const float* base,
-                                                          float s, const float* slope, float c,
-                                                          const float* curve, float* out) {
+// 𝕄 = 𝕄_c + s D₁ + c D₂ with D₁, D₂ in single precision (the portable pass, cloned for AVX-512 F
+// and AVX2 as in mobility_reuse.cc) or in half precision (fluid/mobility_reuse_half.h).
+__attribute__((target_clones("avx512f", "avx2", "default"))) void ExtrapolateSingle(
+    Eigen::Index n, const float* base, float s, const float* slope, float c, const float* curve,
+    float* out) {
 #pragma omp simd
   for (Eigen::Index i = 0; i < n; ++i) out[i] = base[i] + s * slope[i] + c * curve[i];
 }
@@ -189,7 +189,7 @@ void BM_ReuseExtrapolate(benchmark::State& st, bool half) {
   for (auto _ : st) {
     if (half)
       ExtrapolateHalf(out.size(), base.data(), s / slope_scale, slope_half.data(),
-                            c / curve_scale, curve_half.data(), out.data());
+                      c / curve_scale, curve_half.data(), out.data());
     else
       ExtrapolateSingle(out.size(), base.data(), s, slope.data(), c, curve.data(), out.data());
     benchmark::DoNotOptimize(out.data());
@@ -200,12 +200,14 @@ BENCHMARK_CAPTURE(BM_ReuseExtrapolate, half, true)->Unit(benchmark::kMicrosecond
 
 // The preconditioner's solve of one vector with a float LU of size n: Fig. 1's C (3M = 390) and
 // the coarse level's E on 100 helices (2400; from 1024 on, the panels over the OpenMP threads):
-// getrs against the blocked substitution of solver/lu_solve_avx512.cc.
-void BM_FloatLuSolve(benchmark::State& st, bool lapack) {
+// getrs against the blocked substitution of solver/lu_solve_avx512.cc (AVX-512) or
+// lu_solve_avx2.cc, and that substitution on factors in half precision (LuStorage::kHalf, as the
+// preconditioners keep them; where the CPU has neither kernel, kHalf keeps floats).
+void BM_FloatLuSolve(benchmark::State& st, bool lapack, LuStorage storage) {
   const int n = static_cast<int>(st.range(0));
   const Eigen::MatrixXf a = Eigen::MatrixXf::Random(n, n) + n * Eigen::MatrixXf::Identity(n, n);
   DenseLu<float> lu;
-  lu.Compute(a);
+  lu.Compute(a, storage);
   const Eigen::VectorXf b = Eigen::VectorXf::Random(n);
   for (auto _ : st) {
     Eigen::VectorXf x = b;
@@ -213,8 +215,12 @@ void BM_FloatLuSolve(benchmark::State& st, bool lapack) {
     benchmark::DoNotOptimize(x.data());
   }
 }
-BENCHMARK_CAPTURE(BM_FloatLuSolve, getrs, true)->Arg(390)->Arg(2400)->Unit(benchmark::kMicrosecond);
-BENCHMARK_CAPTURE(BM_FloatLuSolve, blocked, false)->Arg(390)->Arg(2400)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_FloatLuSolve, getrs, true, LuStorage::kNative)
+    ->Arg(390)->Arg(2400)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_FloatLuSolve, blocked, false, LuStorage::kNative)
+    ->Arg(390)->Arg(2400)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_FloatLuSolve, half, false, LuStorage::kHalf)
+    ->Arg(390)->Arg(2400)->Unit(benchmark::kMicrosecond);
 
 // The same with LAPACK (dgbtrf, then dgbtrs for one right-hand side), same storage.
 void BM_BandedLapack(benchmark::State& st, bool solve) {

@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <random>
 #include <string>
+#include <vector>
 
 #include <Eigen/LU>
 #if defined(__x86_64__)
@@ -41,6 +42,35 @@ Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic> RandomMatrix(int n, std::m
   return a;
 }
 
+// The single-precision blocked solves and their half-precision twins that this CPU runs
+// (DenseLu takes the widest; the narrower are checked here directly).
+struct LuKernels {
+  const char* name;
+  void (*solve)(int, const float*, const int*, float*);
+  bool (*to_half)(int, const float*, std::uint16_t*, float*);
+  void (*solve_half)(int, const std::uint16_t*, const int*, float, float*);
+  bool half;  // whether the CPU runs to_half and solve_half
+};
+std::vector<LuKernels> KernelsHere() {
+  std::vector<LuKernels> kernels;
+  if (HasLuSolveAvx512())
+    kernels.push_back({"AVX-512", LuSolveAvx512, ConvertLuToHalf, LuSolveHalfAvx512,
+                       HasLuSolveHalfAvx512()});
+  if (HasLuSolveAvx2())
+    kernels.push_back({"AVX2", LuSolveAvx2, ConvertLuToHalfF16c, LuSolveHalfAvx2, true});
+  return kernels;
+}
+
+// getrf's factors and pivots of a, as DenseLu::Compute takes them.
+void Factor(const Eigen::MatrixXf& a, Eigen::MatrixXf* factors, std::vector<int>* pivots) {
+  const int n = static_cast<int>(a.rows());
+  *factors = a;
+  pivots->resize(static_cast<size_t>(n));
+  int info = 0;
+  sgetrf_(&n, &n, factors->data(), &n, pivots->data(), &info);
+  ASSERT_EQ(info, 0);
+}
+
 // Residuals |A x − b| / (|A| |x|): measured ~1e-16 (double) and ~1e-7 (float), like Eigen's.
 TEST(DenseLu, SolvesLikeEigensPartialPivLu) {
   std::mt19937 rng(5);
@@ -64,13 +94,14 @@ TEST(DenseLu, SolvesLikeEigensPartialPivLu) {
   }
 }
 
-// The single-precision solve of one vector on AVX-512 (blocked substitution) against getrs, on
-// sizes around its blocks of 32 columns and 64 rows, and from 1024 on (the panels over the OpenMP
-// threads, blocks of 128 columns): on random matrices the same residuals; on
-// well-conditioned ones (diagonally dominant, rows shuffled so that every column pivots) the same
-// solution to float rounding.
+// The single-precision solve of one vector by each blocked substitution the CPU runs (AVX-512,
+// AVX2) against getrs, on sizes around their blocks of 32 columns and 32 or 64 rows, and from 1024
+// on (the panels over the OpenMP threads, blocks of 128 columns): on random matrices the same
+// residuals; on well-conditioned ones (diagonally dominant, rows shuffled so that every column
+// pivots) the same solution to float rounding.
 TEST(DenseLu, TheBlockedSingleSolveMatchesGetrs) {
-  if (!HasLuSolveAvx512()) GTEST_SKIP() << "no AVX-512 here: getrs is the only path";
+  const std::vector<LuKernels> kernels = KernelsHere();
+  if (kernels.empty()) GTEST_SKIP() << "neither AVX-512 nor AVX2 here: getrs is the only path";
   std::mt19937 rng(9);
   for (const int n : {1, 5, 31, 32, 33, 63, 64, 65, 100, 390, 1023, 1024, 1100, 2400}) {
     Eigen::MatrixXf random = RandomMatrix<float>(n, &rng);
@@ -83,50 +114,80 @@ TEST(DenseLu, TheBlockedSingleSolveMatchesGetrs) {
     for (const Eigen::MatrixXf* a : {&random, &dominant}) {
       DenseLu<float> lu;
       ASSERT_TRUE(lu.Compute(*a));
-      Eigen::VectorXf fast = b, lapack = b;
-      lu.Solve(&fast);
+      Eigen::VectorXf widest = b, lapack = b;
+      lu.Solve(&widest);
       lu.Solve(&lapack, true);
-      const float residual = (*a * fast - b).norm() / (a->norm() * fast.norm());
+      Eigen::MatrixXf factors;
+      std::vector<int> pivots;
+      Factor(*a, &factors, &pivots);
       const float lapack_residual = (*a * lapack - b).norm() / (a->norm() * lapack.norm());
-      EXPECT_LT(residual, 1e-5f) << n;
-      EXPECT_LT(residual, 10.0f * lapack_residual + 1e-6f) << n;
-      if (a == &dominant) {
-        EXPECT_LT((fast - lapack).norm(), 1e-5f * lapack.norm()) << n;
+      for (const LuKernels& kernel : kernels) {
+        Eigen::VectorXf fast = b;
+        kernel.solve(n, factors.data(), pivots.data(), fast.data());
+        // DenseLu's solve is the widest kernel's (on AVX2 getrs from kParallelLuSolve on).
+        const bool dense_lu_takes_it = kernel.solve == LuSolveAvx512 || n < kParallelLuSolve;
+        if (&kernel == &kernels.front() && dense_lu_takes_it) {
+          EXPECT_EQ(fast, widest) << kernel.name << " " << n;
+        }
+        const float residual = (*a * fast - b).norm() / (a->norm() * fast.norm());
+        EXPECT_LT(residual, 1e-5f) << kernel.name << " " << n;
+        EXPECT_LT(residual, 10.0f * lapack_residual + 1e-6f) << kernel.name << " " << n;
+        if (a == &dominant) {
+          EXPECT_LT((fast - lapack).norm(), 1e-5f * lapack.norm()) << kernel.name << " " << n;
+        }
       }
     }
   }
 }
 
-// From n = 1024 the solve's panels run over the OpenMP threads: the same result on any number.
+// From n = 1024 the solves' panels run over the OpenMP threads: the same result on any number,
+// for each kernel, single and half precision.
 TEST(DenseLu, TheBlockedSingleSolveDoesNotDependOnTheThreadCount) {
 #ifdef _OPENMP
-  if (!HasLuSolveAvx512()) GTEST_SKIP() << "no AVX-512 here: getrs is the only path";
+  const std::vector<LuKernels> kernels = KernelsHere();
+  if (kernels.empty()) GTEST_SKIP() << "neither AVX-512 nor AVX2 here: getrs is the only path";
   std::mt19937 rng(4);
   const int n = 1500;
   const Eigen::MatrixXf a = RandomMatrix<float>(n, &rng);
   const Eigen::VectorXf b = RandomMatrix<float>(n, &rng).col(0);
-  DenseLu<float> lu;
-  ASSERT_TRUE(lu.Compute(a));
-  Eigen::VectorXf x[2] = {b, b};
+  Eigen::MatrixXf factors;
+  std::vector<int> pivots;
+  Factor(a, &factors, &pivots);
   const int saved = omp_get_max_threads();
-  for (int threads = 1; threads <= 2; ++threads) {
-    omp_set_num_threads(threads);
-    lu.Solve(&x[threads - 1]);
+  for (const LuKernels& kernel : kernels) {
+    std::vector<std::uint16_t> half(static_cast<size_t>(n) * static_cast<size_t>(n));
+    float scale = 0.0f;
+    if (kernel.half) {
+      ASSERT_TRUE(kernel.to_half(n, factors.data(), half.data(), &scale));
+    }
+    Eigen::VectorXf x[2] = {b, b}, x_half[2] = {b, b};
+    for (int threads = 1; threads <= 2; ++threads) {
+      omp_set_num_threads(threads);
+      kernel.solve(n, factors.data(), pivots.data(), x[threads - 1].data());
+      if (kernel.half)
+        kernel.solve_half(n, half.data(), pivots.data(), scale, x_half[threads - 1].data());
+    }
+    EXPECT_TRUE(x[0] == x[1]) << kernel.name;
+    EXPECT_TRUE(x_half[0] == x_half[1]) << kernel.name;
   }
   omp_set_num_threads(saved);
-  EXPECT_TRUE(x[0] == x[1]);
 #else
   GTEST_SKIP() << "built without OpenMP";
 #endif
 }
 
-// The factors in half precision (LuStorage::kHalf): the half kernel against the single-precision
-// kernel run on the same rounded factors (widened back, U unscaled), to float rounding; and the
-// solve against the single-precision LU's, within the half rounding's effect (2⁻¹¹ per entry on
-// well-conditioned matrices: measured ≤ 1e-3 relative here), on the sizes of
-// TheBlockedSingleSolveMatchesGetrs (from 1024 the parallel panels).
+// The factors in half precision (LuStorage::kHalf): each half kernel against its single-precision
+// kernel run on the same rounded factors (widened back, U unscaled), to float rounding; the two
+// roundings (AVX-512 and AVX2) give the same halves; and DenseLu's solve against the
+// single-precision LU's, within the half rounding's effect (2⁻¹¹ per entry on well-conditioned
+// matrices: measured ≤ 1e-3 relative here), on the sizes of TheBlockedSingleSolveMatchesGetrs
+// (from 1024 the parallel panels).
 TEST(DenseLu, HalfPrecisionFactorsSolveLikeTheirSinglePrecisionValues) {
-  if (!HasLuSolveHalfAvx512()) GTEST_SKIP() << "no AVX-512 BW or F16C here: kHalf keeps floats";
+  std::vector<LuKernels> kernels = KernelsHere();
+  kernels.erase(std::remove_if(kernels.begin(), kernels.end(),
+                               [](const LuKernels& k) { return !k.half; }),
+                kernels.end());
+  if (kernels.empty()) GTEST_SKIP() << "neither AVX-512 BW nor F16C here: kHalf keeps floats";
   std::mt19937 rng(12);
   for (const int n : {1, 5, 31, 32, 33, 64, 65, 195, 390, 1023, 1024, 1100, 2400}) {
     Eigen::MatrixXf a = RandomMatrix<float>(n, &rng) +
@@ -150,21 +211,30 @@ TEST(DenseLu, HalfPrecisionFactorsSolveLikeTheirSinglePrecisionValues) {
       EXPECT_GT(difference, 1e-6f) << n;  // the factors were rounded
     }
 
-    // The reference: the same rounded factors, widened, through the single-precision kernel.
-    Eigen::MatrixXf factors = a;
-    std::vector<int> pivots(static_cast<size_t>(n));
-    int info = 0;  // getrf's factors and pivots, as Compute takes them
-    sgetrf_(&n, &n, factors.data(), &n, pivots.data(), &info);
-    ASSERT_EQ(info, 0);
-    std::vector<std::uint16_t> rounded(static_cast<size_t>(n) * static_cast<size_t>(n));
-    float scale = 0.0f;
-    ASSERT_TRUE(ConvertLuToHalf(n, factors.data(), rounded.data(), &scale));
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i)
-        factors(i, j) = Widen(rounded[static_cast<size_t>(i + j * n)]) / (i <= j ? scale : 1.0f);
-    Eigen::VectorXf x_reference = b;
-    LuSolveAvx512(n, factors.data(), pivots.data(), x_reference.data());
-    EXPECT_LT((x_half - x_reference).norm(), 1e-5f * x_reference.norm()) << n;
+    Eigen::MatrixXf factors;
+    std::vector<int> pivots;
+    Factor(a, &factors, &pivots);
+    std::vector<std::uint16_t> first;
+    for (const LuKernels& kernel : kernels) {
+      std::vector<std::uint16_t> rounded(static_cast<size_t>(n) * static_cast<size_t>(n));
+      float scale = 0.0f;
+      ASSERT_TRUE(kernel.to_half(n, factors.data(), rounded.data(), &scale));
+      if (first.empty()) first = rounded;
+      EXPECT_TRUE(rounded == first) << kernel.name << " " << n;
+      Eigen::VectorXf x_kernel = b;
+      kernel.solve_half(n, rounded.data(), pivots.data(), scale, x_kernel.data());
+      // The reference: the same rounded factors, widened, through the single-precision kernel.
+      Eigen::MatrixXf widened(n, n);
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i)
+          widened(i, j) = Widen(rounded[static_cast<size_t>(i + j * n)]) / (i <= j ? scale : 1.0f);
+      Eigen::VectorXf x_reference = b;
+      kernel.solve(n, widened.data(), pivots.data(), x_reference.data());
+      EXPECT_LT((x_kernel - x_reference).norm(), 1e-5f * x_reference.norm()) << kernel.name << n;
+      if (&kernel == &kernels.front()) {
+        EXPECT_EQ(x_kernel, x_half) << kernel.name << " " << n;  // DenseLu's is the widest
+      }
+    }
   }
 }
 

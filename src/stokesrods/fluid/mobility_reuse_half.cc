@@ -13,6 +13,7 @@
 #include <cmath>
 
 #include "stokesrods/common/assert.h"
+#include "stokesrods/common/cpu_features.h"
 #include "stokesrods/solver/lu_solve_avx512.h"  // HasLuSolveHalfAvx512: the same CPU features
 
 namespace stokesrods {
@@ -136,8 +137,7 @@ SR_F16C void ExtrapolateHalfF16c(Eigen::Index n, const float* base, float a,
 #undef SR_F16C
 
 bool HasF16c() {
-  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
-                          __builtin_cpu_supports("f16c");
+  static const bool has = CpuHasAvx2FmaF16c();
   return has;
 }
 
@@ -153,7 +153,8 @@ float RoundToHalf(Eigen::Index n, float* d, std::uint16_t* half, bool f16c) {
 
 void ExtrapolateHalf(Eigen::Index n, const float* base, float a, const std::uint16_t* slope,
                      float b, const std::uint16_t* curve, float* out, bool f16c) {
-  if (!f16c && HasLuSolveHalfAvx512()) return ExtrapolateHalfAvx512(n, base, a, slope, b, curve, out);
+  if (!f16c && HasLuSolveHalfAvx512())
+    return ExtrapolateHalfAvx512(n, base, a, slope, b, curve, out);
   SR_ASSERT(HasF16c(), "half precision needs AVX-512 BW or F16C");
   ExtrapolateHalfF16c(n, base, a, slope, b, curve, out);
 }

@@ -16,8 +16,9 @@ namespace stokesrods {
 enum class LuStorage {
   kNative,  ///< as getrf leaves them
   /// In IEEE half precision (U scaled by a power of two; lu_solve_avx512.h) where the CPU has
-  /// AVX-512 BW and F16C, else as kNative: half the bytes each solve streams, for preconditioners
-  /// of many blocks whose factors do not stay in cache (a relative rounding of 2⁻¹¹ per entry).
+  /// AVX-512 BW and F16C or AVX2, FMA and F16C, else as kNative: half the bytes each solve
+  /// streams, for preconditioners of many blocks whose factors do not stay in cache (a relative
+  /// rounding of 2⁻¹¹ per entry).
   kHalf,
 };
 
@@ -34,8 +35,10 @@ class DenseLu {
   bool half() const { return !half_.empty(); }
   /// x = A⁻¹ b in place (b's size must be the matrix's). In single precision on AVX-512 by a
   /// blocked substitution of our own (lu_solve_avx512.cc: 8.7 against getrs's 12.1 µs at
-  /// n = 390, bench_step BM_FloatLuSolve), else by getrs; `use_lapack` forces getrs (tests).
-  /// Factors in half precision are always solved by their own kernel (lu_solve_avx512.h).
+  /// n = 390, bench_step BM_FloatLuSolve, an Intel Xeon), on AVX2 with F16C by its twin below
+  /// n = kParallelLuSolve (lu_solve_avx2.cc: 19.7 against 23.8 µs, an AMD EPYC), else by getrs;
+  /// `use_lapack` forces getrs (tests). Factors in half precision are always solved by their own
+  /// kernel (lu_solve_avx512.h).
   void Solve(Vector* b, bool use_lapack = false) const;
   Eigen::Index size() const { return n_; }
   /// Asks the CPU to bring the factors into its L2 cache ahead of a Solve (no effect on results).

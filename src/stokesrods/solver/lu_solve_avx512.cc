@@ -22,7 +22,7 @@ namespace stokesrods {
 #if defined(__GNUC__) && defined(__x86_64__)
 namespace {
 
-constexpr int kBlock = 32;
+constexpr int kBlock = kLuBlock;
 
 // y[0, rows) −= P x, P (rows × cols, column-major, leading dimension ld), the rows in chunks of
 // 64 (the last masked).
@@ -58,9 +58,8 @@ __attribute__((target("avx512f"), always_inline)) inline void SubtractPanel(
 // updated column by column of the block: every column's segment is read once, contiguously (the
 // 64-row panels above read 32 columns at once, 2.3× slower than getrs at n = 2400). Fixed chunks:
 // the result does not depend on the thread count.
-constexpr int kWideBlock = 128;
-constexpr int kChunkRows = 1024;
-constexpr int kParallelLuSolve = 1024;  // n from which LuSolveAvx512 takes this one
+constexpr int kWideBlock = kLuWideBlock;
+constexpr int kChunkRows = kLuChunkRows;
 
 __attribute__((target("avx512f"))) inline void SubtractColumns(int rows, int cols, const float* p,
                                                                Eigen::Index ld, const float* x,

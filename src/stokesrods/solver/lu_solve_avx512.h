@@ -1,10 +1,19 @@
 // One right-hand side of a single-precision LU (as sgetrf leaves it) by a blocked substitution on
-// AVX-512 (lu_solve_avx512.cc); DenseLu<float>::Solve uses it where the CPU has AVX-512.
+// AVX-512 (lu_solve_avx512.cc), or on AVX2 with FMA and F16C (lu_solve_avx2.cc, below);
+// DenseLu<float>::Solve uses the widest the CPU has.
 #pragma once
 
 #include <cstdint>
 
 namespace stokesrods {
+
+/// The blocking of both: the small triangles of kLuBlock columns, then the rows below or above
+/// by the block's panel; from n = kParallelLuSolve blocks of kLuWideBlock columns, the rows in
+/// chunks of kLuChunkRows over the OpenMP threads (fixed chunks: the same result on any number).
+inline constexpr int kLuBlock = 32;
+inline constexpr int kLuWideBlock = 128;
+inline constexpr int kLuChunkRows = 1024;
+inline constexpr int kParallelLuSolve = 1024;
 
 /// x ← A⁻¹ x, A = P L U column-major with leading dimension n, `pivots` 1-based (LAPACK's).
 /// Precondition: HasLuSolveAvx512().
@@ -24,5 +33,15 @@ void LuSolveHalfAvx512(int n, const std::uint16_t* half, const int* pivots, floa
                        float* x);
 /// True when the CPU has AVX-512 F, BW and VL (and so F16C): the half precision loads.
 bool HasLuSolveHalfAvx512();
+
+/// The same three on AVX2 with FMA and F16C (lu_solve_avx2.cc): the substitutions of
+/// LuSolveAvx512 and LuSolveHalfAvx512 on vectors of eight (each row's operations, and so the
+/// results, as theirs), and ConvertLuToHalf's rounding entry by entry (the same bits).
+/// Precondition: HasLuSolveAvx2().
+void LuSolveAvx2(int n, const float* lu, const int* pivots, float* x);
+bool ConvertLuToHalfF16c(int n, const float* lu, std::uint16_t* half, float* u_scale);
+void LuSolveHalfAvx2(int n, const std::uint16_t* half, const int* pivots, float u_scale, float* x);
+/// True when the CPU has AVX2, FMA and F16C.
+bool HasLuSolveAvx2();
 
 }  // namespace stokesrods

@@ -1,0 +1,218 @@
+// The blocked substitutions of lu_solve_avx512.cc on AVX2 with FMA and F16C, for CPUs without
+// AVX-512 (there DenseLu<float> otherwise solves by getrs, whose strsv runs a column at a time,
+// and keeps kHalf factors in single precision). One template over the factors' type, float or
+// IEEE half (widened eight at a time by vcvtph2ps as they are read); vectors of eight, four of
+// them per pass of SubtractPanel (32 rows), and the rows past the last whole vector one by one
+// (no masked loads: AVX2 has none for halves). Each row's operations are those of the AVX-512
+// kernels, fused multiply–adds in the same order.
+#include <immintrin.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <type_traits>
+#include <utility>
+
+#include <Eigen/Core>
+
+#include "stokesrods/common/cpu_features.h"
+#include "stokesrods/solver/lu_solve_avx512.h"
+
+namespace stokesrods {
+
+#if defined(__GNUC__) && defined(__x86_64__)
+#define SR_AVX2 __attribute__((target("avx2,fma,f16c")))
+#define SR_AVX2_INLINE __attribute__((target("avx2,fma,f16c"), always_inline)) inline
+namespace {
+
+constexpr int kRound = _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC;
+
+// Eight entries widened to single precision.
+SR_AVX2_INLINE __m256 Load8(const float* p) { return _mm256_loadu_ps(p); }
+SR_AVX2_INLINE __m256 Load8(const std::uint16_t* p) {
+  return _mm256_cvtph_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)));
+}
+SR_AVX2_INLINE float ToFloat(float v) { return v; }
+SR_AVX2_INLINE float ToFloat(std::uint16_t h) { return _cvtsh_ss(h); }
+
+// y[0, count) −= x · c[0, count) (the small triangles of the blocks, a column's rows): whole
+// vectors of eight, the last rows one by one by the same fused multiply–add.
+template <class E>
+SR_AVX2_INLINE void AxpyShort(int count, const E* c, float x, float* y) {
+  const __m256 xv = _mm256_set1_ps(x);
+  int i = 0;
+  for (; i + 8 <= count; i += 8)
+    _mm256_storeu_ps(y + i, _mm256_fnmadd_ps(Load8(c + i), xv, _mm256_loadu_ps(y + i)));
+  for (; i < count; ++i) y[i] = std::fma(-ToFloat(c[i]), x, y[i]);
+}
+
+// y[0, rows) −= P x, P (rows × cols, column-major, leading dimension ld): 32 rows at a time in
+// four accumulators, the panel's columns streamed once; then whole vectors of eight; the last
+// rows one by one. Each row's sum runs over the columns in order.
+template <class E>
+SR_AVX2_INLINE void SubtractPanel(int rows, int cols, const E* p, Eigen::Index ld, const float* x,
+                                  float* y) {
+  int i0 = 0;
+  for (; i0 + 32 <= rows; i0 += 32) {
+    float* out = y + i0;
+    __m256 a0 = _mm256_loadu_ps(out), a1 = _mm256_loadu_ps(out + 8),
+           a2 = _mm256_loadu_ps(out + 16), a3 = _mm256_loadu_ps(out + 24);
+    for (int j = 0; j < cols; ++j) {
+      const __m256 xj = _mm256_set1_ps(x[j]);
+      const E* column = p + j * ld + i0;
+      a0 = _mm256_fnmadd_ps(Load8(column), xj, a0);
+      a1 = _mm256_fnmadd_ps(Load8(column + 8), xj, a1);
+      a2 = _mm256_fnmadd_ps(Load8(column + 16), xj, a2);
+      a3 = _mm256_fnmadd_ps(Load8(column + 24), xj, a3);
+    }
+    _mm256_storeu_ps(out, a0);
+    _mm256_storeu_ps(out + 8, a1);
+    _mm256_storeu_ps(out + 16, a2);
+    _mm256_storeu_ps(out + 24, a3);
+  }
+  for (; i0 + 8 <= rows; i0 += 8) {
+    __m256 a = _mm256_loadu_ps(y + i0);
+    for (int j = 0; j < cols; ++j)
+      a = _mm256_fnmadd_ps(Load8(p + j * ld + i0), _mm256_set1_ps(x[j]), a);
+    _mm256_storeu_ps(y + i0, a);
+  }
+  for (; i0 < rows; ++i0) {
+    float a = y[i0];
+    for (int j = 0; j < cols; ++j) a = std::fma(-ToFloat(p[j * ld + i0]), x[j], a);
+    y[i0] = a;
+  }
+}
+
+// y[0, rows) −= Σ_j x_j p(:, j), four columns per pass over y (the parallel solve's chunks).
+template <class E>
+SR_AVX2_INLINE void SubtractColumns(int rows, int cols, const E* p, Eigen::Index ld,
+                                    const float* x, float* y) {
+  int j = 0;
+  for (; j + 4 <= cols; j += 4) {
+    const __m256 x0 = _mm256_set1_ps(x[j]), x1 = _mm256_set1_ps(x[j + 1]),
+                 x2 = _mm256_set1_ps(x[j + 2]), x3 = _mm256_set1_ps(x[j + 3]);
+    const E *c0 = p + j * ld, *c1 = c0 + ld, *c2 = c1 + ld, *c3 = c2 + ld;
+    int i = 0;
+    for (; i + 8 <= rows; i += 8) {
+      __m256 a = _mm256_loadu_ps(y + i);
+      a = _mm256_fnmadd_ps(Load8(c0 + i), x0, a);
+      a = _mm256_fnmadd_ps(Load8(c1 + i), x1, a);
+      a = _mm256_fnmadd_ps(Load8(c2 + i), x2, a);
+      a = _mm256_fnmadd_ps(Load8(c3 + i), x3, a);
+      _mm256_storeu_ps(y + i, a);
+    }
+    for (; i < rows; ++i) {
+      float a = std::fma(-ToFloat(c0[i]), x[j], y[i]);
+      a = std::fma(-ToFloat(c1[i]), x[j + 1], a);
+      a = std::fma(-ToFloat(c2[i]), x[j + 2], a);
+      y[i] = std::fma(-ToFloat(c3[i]), x[j + 3], a);
+    }
+  }
+  for (; j < cols; ++j) AxpyShort(rows, p + j * ld, x[j], y);
+}
+
+// U's factors in half precision are scaled by u_scale: U' x = u_scale y.
+template <class E>
+SR_AVX2_INLINE void ScaleForU(int n, float u_scale, float* x) {
+  if constexpr (std::is_same_v<E, std::uint16_t>)
+    for (int i = 0; i < n; ++i) x[i] *= u_scale;
+}
+
+template <class E>
+SR_AVX2 void LuSolveParallel(int n, const E* lu, const int* pivots, float u_scale, float* x) {
+  for (int i = 0; i < n; ++i)
+    if (pivots[i] - 1 != i) std::swap(x[i], x[pivots[i] - 1]);
+  const Eigen::Index ld = n;
+#pragma omp parallel
+  {
+    for (int j0 = 0; j0 < n; j0 += kLuWideBlock) {  // L (unit diagonal), from the top
+      const int j1 = std::min(j0 + kLuWideBlock, n);
+#pragma omp single
+      for (int j = j0; j < j1; ++j) AxpyShort(j1 - j - 1, lu + j + 1 + j * ld, x[j], x + j + 1);
+#pragma omp for schedule(static)
+      for (int r = j1; r < n; r += kLuChunkRows)
+        SubtractColumns(std::min(kLuChunkRows, n - r), j1 - j0, lu + r + j0 * ld, ld, x + j0,
+                        x + r);
+    }
+#pragma omp single
+    ScaleForU<E>(n, u_scale, x);
+    for (int j1 = n; j1 > 0; j1 -= kLuWideBlock) {  // U, from the bottom
+      const int j0 = std::max(j1 - kLuWideBlock, 0);
+#pragma omp single
+      for (int j = j1 - 1; j >= j0; --j) {
+        x[j] /= ToFloat(lu[j + j * ld]);
+        AxpyShort(j - j0, lu + j0 + j * ld, x[j], x + j0);
+      }
+#pragma omp for schedule(static)
+      for (int r = 0; r < j0; r += kLuChunkRows)
+        SubtractColumns(std::min(kLuChunkRows, j0 - r), j1 - j0, lu + r + j0 * ld, ld, x + j0,
+                        x + r);
+    }
+  }
+}
+
+template <class E>
+SR_AVX2 void LuSolve(int n, const E* lu, const int* pivots, float u_scale, float* x) {
+  if (n >= kParallelLuSolve) return LuSolveParallel(n, lu, pivots, u_scale, x);
+  for (int i = 0; i < n; ++i)
+    if (pivots[i] - 1 != i) std::swap(x[i], x[pivots[i] - 1]);
+  const Eigen::Index ld = n;
+  for (int j0 = 0; j0 < n; j0 += kLuBlock) {  // L (unit diagonal), blocks from the top
+    const int j1 = std::min(j0 + kLuBlock, n);
+    for (int j = j0; j < j1; ++j) AxpyShort(j1 - j - 1, lu + j + 1 + j * ld, x[j], x + j + 1);
+    SubtractPanel(n - j1, j1 - j0, lu + j1 + j0 * ld, ld, x + j0, x + j1);
+  }
+  ScaleForU<E>(n, u_scale, x);
+  for (int j1 = n; j1 > 0; j1 -= kLuBlock) {  // U, blocks from the bottom
+    const int j0 = std::max(j1 - kLuBlock, 0);
+    for (int j = j1 - 1; j >= j0; --j) {
+      const float xj = x[j] / ToFloat(lu[j + j * ld]);
+      x[j] = xj;
+      AxpyShort(j - j0, lu + j0 + j * ld, xj, x + j0);
+    }
+    SubtractPanel(j0, j1 - j0, lu + j0 * ld, ld, x + j0, x);
+  }
+}
+
+}  // namespace
+
+void LuSolveAvx2(int n, const float* lu, const int* pivots, float* x) {
+  LuSolve(n, lu, pivots, 1.0f, x);
+}
+
+void LuSolveHalfAvx2(int n, const std::uint16_t* half, const int* pivots, float u_scale,
+                     float* x) {
+  LuSolve(n, half, pivots, u_scale, x);
+}
+
+SR_AVX2 bool ConvertLuToHalfF16c(int n, const float* lu, std::uint16_t* half, float* u_scale) {
+  const Eigen::Index ld = n;
+  float largest = 0.0f;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i <= j; ++i) largest = std::max(largest, std::abs(lu[i + j * ld]));
+  if (!std::isfinite(largest)) return false;
+  const float scale = largest > 0.0f ? std::ldexp(1.0f, 14 - std::ilogb(largest)) : 1.0f;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {  // U (row ≤ j) scaled, L as it is
+      const float v = lu[i + j * ld];
+      half[i + j * ld] = _cvtss_sh(i <= j ? v * scale : v, kRound);
+    }
+  *u_scale = scale;
+  return true;
+}
+
+bool HasLuSolveAvx2() {
+  static const bool has = CpuHasAvx2FmaF16c();
+  return has;
+}
+#undef SR_AVX2
+#undef SR_AVX2_INLINE
+
+#else
+void LuSolveAvx2(int, const float*, const int*, float*) {}
+void LuSolveHalfAvx2(int, const std::uint16_t*, const int*, float, float*) {}
+bool ConvertLuToHalfF16c(int, const float*, std::uint16_t*, float*) { return false; }
+bool HasLuSolveAvx2() { return false; }
+#endif
+
+}  // namespace stokesrods
