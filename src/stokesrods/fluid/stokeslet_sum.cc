@@ -4,18 +4,14 @@
 // MEASURED (one thread): on an AMD EPYC with AVX-512 (1280 sources × 650 targets, one target at a
 // time) the direct sum on AVX-512 intrinsics (point_sum_simd.h) cost 0.46 ns per pair in double
 // and 0.18 ns in single precision (the compiler's vectorization of the portable loops, kept for
-// CPUs without AVX2: 1.6 and 0.22 ns); on one without (point_sum_avx2.cc) 1.5 and 0.59 ns on AVX2
-// intrinsics against 6.0 and 0.88 ns portable; on an Intel Xeon (Emerald Rapids; 2560 × 1300, BM_StokesletSumApply/20/4/0)
-// 0.52 ns in single precision one target at a time with the IEEE square root, 0.38 ns four at a
-// time with rsqrt14; in double 1.76 and 0.9 ns.
+// CPUs without AVX2: 1.6 and 0.22 ns); on an AMD EPYC without AVX-512 (point_sum_avx2.cc) 1.5 and
+// 0.59 ns on AVX2 intrinsics against 6.0 and 0.88 ns portable; on an Intel Xeon (Emerald Rapids;
+// 2560 × 1300, BM_StokesletSumApply/20/4/0) 0.52 ns in single precision one target at a time with
+// the IEEE square root, 0.38 ns four at a time with rsqrt14; in double 1.76 and 0.9 ns.
 #include "stokesrods/fluid/stokeslet_sum.h"
 
 #include <algorithm>
 #include <cmath>
-
-#if defined(__x86_64__)
-#include <immintrin.h>
-#endif
 
 #include "stokesrods/common/assert.h"
 #include "stokesrods/fluid/point_stokeslet.h"

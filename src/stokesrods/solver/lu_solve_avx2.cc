@@ -118,6 +118,34 @@ SR_AVX2_INLINE void ScaleForU(int n, float u_scale, float* x) {
     for (int i = 0; i < n; ++i) x[i] *= u_scale;
 }
 
+// The parallel solve's pieces, out of line: clang outlines an OpenMP region into a function
+// without its parent's target attributes, and a half conversion inlined there became a library
+// call (__gnu_h2f_ieee, which the fuzzer's link lacks). Called from the region, these keep theirs.
+#define SR_AVX2_CALLED __attribute__((target("avx2,fma,f16c"), noinline))
+// L's columns [j0, j1) within their block: x[j + 1, j1) −= x_j L(j + 1 … j1 − 1, j).
+template <class E>
+SR_AVX2_CALLED void LowerTriangle(int j0, int j1, const E* lu, Eigen::Index ld, float* x) {
+  for (int j = j0; j < j1; ++j) AxpyShort(j1 - j - 1, lu + j + 1 + j * ld, x[j], x + j + 1);
+}
+// U's columns [j0, j1) within their block, from the bottom.
+template <class E>
+SR_AVX2_CALLED void UpperTriangle(int j0, int j1, const E* lu, Eigen::Index ld, float* x) {
+  for (int j = j1 - 1; j >= j0; --j) {
+    x[j] /= ToFloat(lu[j + j * ld]);
+    AxpyShort(j - j0, lu + j0 + j * ld, x[j], x + j0);
+  }
+}
+template <class E>
+SR_AVX2_CALLED void SubtractColumnsCalled(int rows, int cols, const E* p, Eigen::Index ld,
+                                          const float* x, float* y) {
+  SubtractColumns(rows, cols, p, ld, x, y);
+}
+template <class E>
+SR_AVX2_CALLED void ScaleForUCalled(int n, float u_scale, float* x) {
+  ScaleForU<E>(n, u_scale, x);
+}
+#undef SR_AVX2_CALLED
+
 template <class E>
 SR_AVX2 void LuSolveParallel(int n, const E* lu, const int* pivots, float u_scale, float* x) {
   for (int i = 0; i < n; ++i)
@@ -128,25 +156,22 @@ SR_AVX2 void LuSolveParallel(int n, const E* lu, const int* pivots, float u_scal
     for (int j0 = 0; j0 < n; j0 += kLuWideBlock) {  // L (unit diagonal), from the top
       const int j1 = std::min(j0 + kLuWideBlock, n);
 #pragma omp single
-      for (int j = j0; j < j1; ++j) AxpyShort(j1 - j - 1, lu + j + 1 + j * ld, x[j], x + j + 1);
+      LowerTriangle(j0, j1, lu, ld, x);
 #pragma omp for schedule(static)
       for (int r = j1; r < n; r += kLuChunkRows)
-        SubtractColumns(std::min(kLuChunkRows, n - r), j1 - j0, lu + r + j0 * ld, ld, x + j0,
-                        x + r);
+        SubtractColumnsCalled(std::min(kLuChunkRows, n - r), j1 - j0, lu + r + j0 * ld, ld,
+                              x + j0, x + r);
     }
 #pragma omp single
-    ScaleForU<E>(n, u_scale, x);
+    ScaleForUCalled<E>(n, u_scale, x);
     for (int j1 = n; j1 > 0; j1 -= kLuWideBlock) {  // U, from the bottom
       const int j0 = std::max(j1 - kLuWideBlock, 0);
 #pragma omp single
-      for (int j = j1 - 1; j >= j0; --j) {
-        x[j] /= ToFloat(lu[j + j * ld]);
-        AxpyShort(j - j0, lu + j0 + j * ld, x[j], x + j0);
-      }
+      UpperTriangle(j0, j1, lu, ld, x);
 #pragma omp for schedule(static)
       for (int r = 0; r < j0; r += kLuChunkRows)
-        SubtractColumns(std::min(kLuChunkRows, j0 - r), j1 - j0, lu + r + j0 * ld, ld, x + j0,
-                        x + r);
+        SubtractColumnsCalled(std::min(kLuChunkRows, j0 - r), j1 - j0, lu + r + j0 * ld, ld,
+                              x + j0, x + r);
     }
   }
 }
