@@ -118,9 +118,10 @@ SR_AVX2_INLINE void ScaleForU(int n, float u_scale, float* x) {
     for (int i = 0; i < n; ++i) x[i] *= u_scale;
 }
 
-// The parallel solve's pieces, out of line: clang outlines an OpenMP region into a function
-// without its parent's target attributes, and a half conversion inlined there became a library
-// call (__gnu_h2f_ieee, which the fuzzer's link lacks). Called from the region, these keep theirs.
+// The solves' pieces, out of line (one call per block of columns): clang outlines an OpenMP
+// region into a function without its parent's target attributes, and a half conversion inlined
+// there became a library call (__gnu_h2f_ieee, which the fuzzer's link lacks). Called from the
+// region, these keep theirs.
 #define SR_AVX2_CALLED __attribute__((target("avx2,fma,f16c"), noinline))
 // L's columns [j0, j1) within their block: x[j + 1, j1) −= x_j L(j + 1 … j1 − 1, j).
 template <class E>
@@ -184,17 +185,13 @@ SR_AVX2 void LuSolve(int n, const E* lu, const int* pivots, float u_scale, float
   const Eigen::Index ld = n;
   for (int j0 = 0; j0 < n; j0 += kLuBlock) {  // L (unit diagonal), blocks from the top
     const int j1 = std::min(j0 + kLuBlock, n);
-    for (int j = j0; j < j1; ++j) AxpyShort(j1 - j - 1, lu + j + 1 + j * ld, x[j], x + j + 1);
+    LowerTriangle(j0, j1, lu, ld, x);
     SubtractPanel(n - j1, j1 - j0, lu + j1 + j0 * ld, ld, x + j0, x + j1);
   }
   ScaleForU<E>(n, u_scale, x);
   for (int j1 = n; j1 > 0; j1 -= kLuBlock) {  // U, blocks from the bottom
     const int j0 = std::max(j1 - kLuBlock, 0);
-    for (int j = j1 - 1; j >= j0; --j) {
-      const float xj = x[j] / ToFloat(lu[j + j * ld]);
-      x[j] = xj;
-      AxpyShort(j - j0, lu + j0 + j * ld, xj, x + j0);
-    }
+    UpperTriangle(j0, j1, lu, ld, x);
     SubtractPanel(j0, j1 - j0, lu + j0 * ld, ld, x + j0, x);
   }
 }
