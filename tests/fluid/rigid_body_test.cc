@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -85,6 +86,30 @@ TEST(RigidBody, ProlateSpheroidDragMatchesTheClosedForms) {
   EXPECT_LT(std::abs(r(1, 1) / transverse - 1.0), 0.12 * spacing / b);
   RecordProperty("axial_error", std::to_string(r(2, 2) / axial - 1.0));
   RecordProperty("transverse_error", std::to_string(r(0, 0) / transverse - 1.0));
+}
+
+// SpheroidSurface turns the stretched sphere onto its axis: every point lies on the spheroid
+// about that axis, the two poles (the first and last points, nearest ±e_z before the turn) lie
+// along it, for axes along, against and nearly against e_z and tilted ones.
+TEST(RigidBody, SpheroidSurfaceLiesOnTheSpheroidAboutItsAxis) {
+  const double b = 0.5, a = 1.0;
+  const Vec3 center(0.3, -0.2, 0.7);
+  for (const Vec3& axis : {Vec3(0.0, 0.0, 1.0), Vec3(0.0, 0.0, -2.0), Vec3(1e-9, 0.0, -1.0),
+                           Vec3(1.0, 0.0, 1.0), Vec3(0.3, -0.5, 0.2), Vec3(0.0, 1.0, 0.0)}) {
+    const BodySurface s = SpheroidSurface(center, b, a, axis, 400, kBlob);
+    const Vec3 unit = axis.normalized();
+    double worst = 0.0;
+    for (Eigen::Index i = 0; i < s.points.cols(); ++i) {
+      const Vec3 p = s.points.col(i) - center;
+      const double along = p.dot(unit), across2 = (p - along * unit).squaredNorm();
+      worst = std::max(worst, std::abs(along * along / (a * a) + across2 / (b * b) - 1.0));
+    }
+    EXPECT_LT(worst, 1e-14) << axis.transpose();
+    const Vec3 first = s.points.col(0) - center;
+    const Vec3 last = s.points.col(s.points.cols() - 1) - center;
+    EXPECT_GT(first.dot(unit), 0.99 * a) << axis.transpose();
+    EXPECT_LT(last.dot(unit), -0.99 * a) << axis.transpose();
+  }
 }
 
 // A rigid swimmer: a right-handed (handedness 1) or left-handed (−1) helix below a sphere, as the

@@ -1,6 +1,5 @@
 #include "stokesrods/fluid/fmm_operators.h"
 
-#include <Eigen/Dense>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -10,6 +9,7 @@
 #include "stokesrods/common/assert.h"
 #include "stokesrods/fluid/point_stokeslet.h"
 #include "stokesrods/fluid/stokeslet_segment.h"
+#include "stokesrods/solver/dense_spectral.h"
 
 namespace stokesrods {
 namespace {
@@ -35,16 +35,6 @@ MatX KernelMatrix(const Matrix3X& x, const Matrix3X& y) {
     for (Eigen::Index i = 0; i < x.cols(); ++i)
       k.block<3, 3>(3 * i, 3 * j) = StokesletMatrix(x.col(i) - y.col(j));
   return k;
-}
-
-/// The pseudo-inverse, singular values below cutoff · σ_max dropped.
-MatX PseudoInverse(const MatX& a, double cutoff) {
-  Eigen::BDCSVD<MatX> svd(a, Eigen::ComputeThinU | Eigen::ComputeThinV);
-  const VecX& s = svd.singularValues();
-  VecX inv = VecX::Zero(s.size());
-  for (Eigen::Index i = 0; i < s.size(); ++i)
-    if (s[i] > cutoff * s[0]) inv[i] = 1.0 / s[i];
-  return svd.matrixV() * inv.asDiagonal() * svd.matrixU().transpose();
 }
 
 std::unique_ptr<FmmOperators> MakeOperators(int order, double cutoff) {

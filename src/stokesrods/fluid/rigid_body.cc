@@ -2,7 +2,6 @@
 
 #include <cmath>
 
-#include <Eigen/Geometry>
 #include <Eigen/LU>
 
 #include "stokesrods/common/assert.h"
@@ -11,6 +10,22 @@
 #include "stokesrods/fluid/stokeslet_segment.h"
 
 namespace stokesrods {
+namespace {
+
+// The rotation about e_z × a that takes e_z to the unit vector a (Rodrigues:
+// I + [v]× + [v]×²/(1 + c), v = e_z × a, c = a_z), a half-turn about e_x for a = −e_z. Near that
+// case 1/(1 + c) is taken as (1 − c)/|v|², free of cancellation. (Eigen's
+// Quaternion::FromTwoVectors gives the same rotation, but its SVD for the antiparallel case took
+// a quarter of this file's compile time.)
+Mat3 TurnZTo(const Vec3& a) {
+  const double c = a.z(), s2 = a.x() * a.x() + a.y() * a.y();
+  if (s2 == 0.0) return c > 0.0 ? Mat3::Identity() : Mat3(Vec3(1.0, -1.0, -1.0).asDiagonal());
+  Mat3 k;  // [v]×, v = (−a_y, a_x, 0)
+  k << 0.0, 0.0, a.x(), 0.0, 0.0, a.y(), -a.x(), -a.y(), 0.0;
+  return Mat3::Identity() + k + (c >= 0.0 ? 1.0 / (1.0 + c) : (1.0 - c) / s2) * (k * k);
+}
+
+}  // namespace
 
 Matrix3X FibonacciSphere(int n) {
   SR_ASSERT(n >= 2, "a sphere needs at least 2 points");
@@ -48,7 +63,7 @@ BodySurface SpheroidSurface(const Vec3& center, double radius, double half_lengt
   unit.row(0) *= b;
   unit.row(1) *= b;
   unit.row(2) *= a;
-  const Mat3 turn = Eigen::Quaterniond::FromTwoVectors(Vec3::UnitZ(), axis.normalized()).toRotationMatrix();
+  const Mat3 turn = TurnZTo(axis.normalized());
   BodySurface s;
   s.points = (turn * unit).colwise() + center;
   s.regularization = blob_over_spacing * std::sqrt(area / n);

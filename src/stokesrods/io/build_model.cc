@@ -5,16 +5,17 @@
 #include <complex>
 #include <limits>
 
-#include <Eigen/Eigenvalues>
-#include <Eigen/LU>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "stokesrods/common/assert.h"
 #include "stokesrods/fluid/lsbt.h"
 #include "stokesrods/sim/observables.h"
 #include "stokesrods/fluid/rft.h"
 #include "stokesrods/rod/geometry.h"
+#include "stokesrods/solver/dense_lu.h"
+#include "stokesrods/solver/dense_spectral.h"
 #include "stokesrods/sim/hydro_coupling.h"
 #include "stokesrods/sim/contact_forces.h"
 #include "stokesrods/sim/observables.h"
@@ -123,7 +124,15 @@ double ExplicitStepLimit(const Model& model) {
     positions.push_back(RodPositions(model, r, rest.q));
   MatX mobility;
   AssembleMobility(model.fluid, MakeHydroRods(model, positions), &mobility);
-  const MatX resistance = mobility.partialPivLu().inverse();
+  DenseLu<double> lu;
+  const bool factorized = lu.Compute(mobility);
+  SR_ASSERT(factorized, "ExplicitStepLimit: the mobility is singular");
+  MatX resistance = MatX::Identity(mobility.rows(), mobility.cols());  // 𝕄⁻¹, column by column
+  for (Eigen::Index j = 0; j < resistance.cols(); ++j) {
+    VecX column = resistance.col(j);
+    lu.Solve(&column);
+    resistance.col(j) = column;
+  }
   std::vector<Eigen::Index> free;
   VecX mass;
   std::vector<double> masses;
@@ -138,7 +147,7 @@ double ExplicitStepLimit(const Model& model) {
   MatX a(n, n);
   for (Eigen::Index i = 0; i < n; ++i)
     for (Eigen::Index j = 0; j < n; ++j) a(i, j) = resistance(free[i], free[j]) / masses[i];
-  const Eigen::VectorXcd lambda = a.eigenvalues();
+  const Eigen::VectorXcd lambda = Eigenvalues(a);
   double limit = std::numeric_limits<double>::infinity();
   for (const std::complex<double>& l : lambda)
     if (l.real() > 0.0) limit = std::min(limit, 2.0 * l.real() / std::norm(l));
