@@ -14,9 +14,8 @@
 #include <cstdio>
 #include <random>
 
-#include <Eigen/SVD>
-
 #include "common/helix_lattice.h"
+#include "stokesrods/solver/dense_spectral.h"
 
 namespace stokesrods {
 namespace {
@@ -129,7 +128,10 @@ TEST(CoarseLevel, SolveInvertsZTransposeW) {
   // smaller). Residual within 2 u ‖E‖₂ ‖c‖ (measured 0.13 u ‖E‖₂ ‖c‖, which E's conditioning
   // makes 1.1 % of ‖Zᵀv‖; below 7e-4 of it with single-precision factors, the bound of before);
   // an E inconsistent with W would miss by O(‖Zᵀv‖).
-  const double norm_e = Eigen::JacobiSVD<MatX>(ztw).singularValues()(0);
+  MatX u_svd, v_svd;
+  VecX sigma;
+  ASSERT_TRUE(ThinSvd(ztw, &u_svd, &sigma, &v_svd));
+  const double norm_e = sigma(0);
   const double residual = (ztw * c - ztv).norm();
   std::printf("  coarse solve: residual %.2e of ‖E‖‖c‖, %.2e of ‖Zᵀv‖\n",
               residual / (norm_e * c.norm()), residual / ztv.norm());

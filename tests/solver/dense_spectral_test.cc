@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <complex>
 #include <random>
 #include <vector>
@@ -83,6 +84,21 @@ TEST(DenseSvd, InverseOfAnInvertibleMatrix) {
   std::mt19937 rng(3);
   const Eigen::MatrixXd a = Random(20, 20, &rng) + 10.0 * Eigen::MatrixXd::Identity(20, 20);
   EXPECT_LT(Deviation(PseudoInverse(a, 0.0) * a, Eigen::MatrixXd::Identity(20, 20)), 1e-13);
+}
+
+// Q diag(λ) Qᵀ with Q from the SVD of a random matrix: the λ back, in increasing order.
+TEST(DenseSpectral, SymmetricEigenvaluesOfAMatrixBuiltFromThem) {
+  std::mt19937 rng(13);
+  Eigen::MatrixXd q, v;
+  Eigen::VectorXd s;
+  ASSERT_TRUE(ThinSvd(Random(9, 9, &rng), &q, &s, &v));
+  Eigen::VectorXd lambda(9);
+  lambda << 4.0, -2.0, 0.0, 1e-6, 7.5, -2.0, 3.0, -9.0, 0.5;
+  const Eigen::MatrixXd a = q * lambda.asDiagonal() * q.transpose();
+  const Eigen::VectorXd w = SymmetricEigenvalues(a);
+  std::sort(lambda.begin(), lambda.end());
+  ASSERT_EQ(w.size(), 9);
+  EXPECT_LT((w - lambda).cwiseAbs().maxCoeff(), 1e-13 * 9.0);
 }
 
 // A block upper triangular matrix (1 × 1 and 2 × 2 diagonal blocks [[a, −b], [b, a]], whose

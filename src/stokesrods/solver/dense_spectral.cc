@@ -10,6 +10,9 @@ extern "C" {
 void dgesdd_(const char* jobz, const int* m, const int* n, double* a, const int* lda, double* s,
              double* u, const int* ldu, double* vt, const int* ldvt, double* work,
              const int* lwork, int* iwork, int* info, std::size_t jobz_len);
+void dsyevd_(const char* jobz, const char* uplo, const int* n, double* a, const int* lda,
+             double* w, double* work, const int* lwork, int* iwork, const int* liwork, int* info,
+             std::size_t jobz_len, std::size_t uplo_len);
 void dgeev_(const char* jobvl, const char* jobvr, const int* n, double* a, const int* lda,
             double* wr, double* wi, double* vl, const int* ldvl, double* vr, const int* ldvr,
             double* work, const int* lwork, int* info, std::size_t jobvl_len,
@@ -55,6 +58,27 @@ Eigen::MatrixXd PseudoInverse(const Eigen::MatrixXd& a, double cutoff) {
   for (Eigen::Index i = 0; i < s.size(); ++i)  // V diag(1/s) Uᵀ, column by column of V
     v.col(i) *= s[i] > cutoff * s[0] ? 1.0 / s[i] : 0.0;
   return v * u.transpose();
+}
+
+Eigen::VectorXd SymmetricEigenvalues(const Eigen::MatrixXd& a) {
+  SR_ASSERT(a.rows() == a.cols(), "SymmetricEigenvalues: the matrix must be square");
+  (void)BlasIsSingleThreaded();
+  const int n = static_cast<int>(a.rows());
+  Eigen::VectorXd w(n);
+  if (n == 0) return w;
+  Eigen::MatrixXd work_a = a;  // overwritten
+  double size = 0.0;
+  int isize = 0, info = 0, lwork = -1, liwork = -1;
+  dsyevd_("N", "L", &n, work_a.data(), &n, w.data(), &size, &lwork, &isize, &liwork, &info, 1, 1);
+  SR_ASSERT(info == 0, "dsyevd: the workspace query failed");
+  lwork = static_cast<int>(size);
+  liwork = std::max(isize, 1);
+  std::vector<double> work(static_cast<std::size_t>(std::max(lwork, 1)));
+  std::vector<int> iwork(static_cast<std::size_t>(liwork));
+  dsyevd_("N", "L", &n, work_a.data(), &n, w.data(), work.data(), &lwork, iwork.data(), &liwork,
+          &info, 1, 1);
+  SR_ASSERT(info == 0, "dsyevd: the iteration did not converge");
+  return w;
 }
 
 Eigen::VectorXcd Eigenvalues(const Eigen::MatrixXd& a) {

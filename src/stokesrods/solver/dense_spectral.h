@@ -1,7 +1,7 @@
 // Spectral decompositions of dense matrices by LAPACK (OpenBLAS): the thin singular value
 // decomposition (dgesdd, divide and conquer) and the pseudo-inverse built on it, for the FMM's
 // translation operators; the eigenvalues of a general matrix (dgeev), for the explicit scheme's
-// stable step. Each is used once per run. Eigen's BDCSVD and EigenSolver do the same, but their
+// stable step, and of a symmetric one (dsyevd), for the tests' spectra. Each is used once per run. Eigen's BDCSVD and EigenSolver do the same, but their
 // instantiations took 50–80 s of compile time per file under the sanitizers (docs/reliability.md,
 // "The build on the AMD host").
 #pragma once
@@ -21,6 +21,10 @@ bool ThinSvd(const Eigen::MatrixXd& a, Eigen::MatrixXd* u, Eigen::VectorXd* s,
 /// The pseudo-inverse V diag(1/s) Uᵀ (n × m), the singular values at or below cutoff · s_max
 /// dropped (0 ≤ cutoff < 1). Stops the program if the SVD fails (it converges for any finite a).
 Eigen::MatrixXd PseudoInverse(const Eigen::MatrixXd& a, double cutoff);
+
+/// The eigenvalues of a symmetric matrix (its lower triangle is read) in increasing order, by
+/// dsyevd. Stops the program if LAPACK's iteration fails.
+Eigen::VectorXd SymmetricEigenvalues(const Eigen::MatrixXd& a);
 
 /// The eigenvalues of a square matrix, complex conjugate pairs next to each other, in no
 /// particular order. Stops the program if LAPACK's QR iteration fails.
