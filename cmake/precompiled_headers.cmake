@@ -1,6 +1,6 @@
 # Precompiled headers (GCC, STOKESRODS_PCH): Eigen's headers (and GoogleTest's for the tests) are
 # parsed once per build instead of once per file, which took a third of each file's compile time
-# (docs/performance.md, "The build"). Two headers only, each shared by REUSE_FROM: one for the
+# (docs/reliability.md, "The build on the AMD host"). Two headers only, each shared by REUSE_FROM: one for the
 # module libraries (position-independent code), one for the test programs (position-independent
 # executables); GCC uses a precompiled header only where the flags and macros it depends on are
 # those it was made with, and otherwise reads the headers as text (no other effect). Files with
