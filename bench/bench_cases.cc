@@ -332,6 +332,14 @@ int RunCase(const Options& options, const CaseSpec& spec, nlohmann::ordered_json
         Number(ms.empty() ? std::nan("") : static_cast<double>(reuse.assemblies - reuse_start.assemblies) / n);
     j["reuse_largest_error"] = reuse.largest_error;
   }
+  // The matrix-free operator's work per product at the last step: its near 3×3 blocks and its
+  // far sum's cost in kernel evaluations (source–target pairs where the sum is direct).
+  if (ws.nonlocal_fluid && model.hydro.mobility.kind == MobilityKind::kMatrixFree) {
+    const MobilityCostCounts cost = ws.hydro.mobility().cost_counts();
+    j["near_blocks"] = cost.near_blocks;
+    j["far_cost_per_product"] = cost.far_sum_cost;
+    j["gauss_points"] = cost.gauss_points;
+  }
   j["ok"] = failure.empty();
   if (!failure.empty()) j["message"] = failure;
   return failure.empty() ? 0 : 3;

@@ -1,5 +1,6 @@
 #include "stokesrods/fluid/rss.h"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 #include <vector>
@@ -60,27 +61,59 @@ void AssembleRssMobility(const FluidParams& params, const std::vector<HydroRod>&
       target_node.emplace_back(static_cast<int>(r), i);
     offset += rods[r].x->cols();
   }
+  // Targets in chunks of kChunk consecutive nodes: each chunk's rows are computed first, then
+  // written column by column, 3 kChunk consecutive entries of each column of the column-major 𝕄
+  // (a target's three rows alone wrote 3 doubles per column, entry by entry; perf put 31 % of
+  // the assembly there). MEASURED (AMD EPYC, one thread, bench_step BM_RssMobilityAssembly/2,
+  // 390 × 390, medians of 5, two sittings): 0.86–1.05 → 0.66–0.67 ms; the same bits.
+  constexpr Eigen::Index kChunk = 8;
+  const Eigen::Index chunks = (total + kChunk - 1) / kChunk;
 #pragma omp parallel
   {
-    std::vector<double> table;  // per thread: 12 rows × segments
-#pragma omp for schedule(dynamic, 8)
-    for (Eigen::Index target = 0; target < total; ++target) {
-      const auto [rod, column] = target_node[static_cast<size_t>(target)];
-      const Vec3 point = rods[static_cast<size_t>(rod)].x->col(column);
+    std::vector<double> tables;   // per thread: kChunk tables of 12 rows × segments
+    std::vector<double> entries;  // and their 6 entries per node
+#pragma omp for schedule(dynamic, 1)
+    for (Eigen::Index chunk = 0; chunk < chunks; ++chunk) {
+      const Eigen::Index first_target = chunk * kChunk;
+      const auto count = static_cast<int>(std::min(kChunk, total - first_target));
       for (std::size_t r = 0; r < sources.size(); ++r) {
         const int n = sources[r].segments();
-        table.resize(static_cast<size_t>(12 * n));
-        sources[r].Row(point, 0, n, table.data());
-        // Node k collects A_a of segment k and A_b of segment k − 1.
+        const auto size = static_cast<size_t>(12 * n);
+        tables.resize(size * kChunk);
+        for (int t = 0; t < count; ++t) {
+          const auto [rod, column] = target_node[static_cast<size_t>(first_target + t)];
+          const Vec3 point = rods[static_cast<size_t>(rod)].x->col(column);
+          sources[r].Row(point, 0, n, tables.data() + t * size);
+        }
+        // Node k collects A_a of segment k and A_b of segment k − 1, times 1/(8πμ Δl_k): the
+        // six entries per node, by rows over the nodes (vectorized), then written by columns.
+        const double* w = node_scale[r].data();
+        const auto stride = static_cast<size_t>(n) + 1;
+        entries.resize(6 * stride * kChunk);
+        for (int t = 0; t < count; ++t) {
+          const double* table = tables.data() + t * size;
+          for (int c = 0; c < 6; ++c) {
+            const double* a = table + c * n;
+            const double* b = table + (6 + c) * n;
+            double* e = entries.data() + (6 * t + c) * stride;
+            e[0] = w[0] * (a[0] + 0.0);
+#pragma omp simd
+            for (int k = 1; k < n; ++k) e[k] = w[k] * (a[k] + b[k - 1]);
+            e[n] = w[n] * (0.0 + b[n - 1]);
+          }
+        }
+        const Eigen::Index ld = mobility->rows();
         for (int k = 0; k <= n; ++k) {
-          double e[6];
-          for (int c = 0; c < 6; ++c)
-            e[c] = (k < n ? table[static_cast<size_t>(c * n + k)] : 0.0) +
-                   (k > 0 ? table[static_cast<size_t>((6 + c) * n + k - 1)] : 0.0);
-          const double w = node_scale[r](k);
-          auto block = mobility->block<3, 3>(3 * target, 3 * (first_node[r] + k));
-          block << w * e[0], w * e[1], w * e[2], w * e[1], w * e[3], w * e[4], w * e[2],
-              w * e[4], w * e[5];
+          double* col = mobility->data() + (3 * (first_node[r] + k)) * ld + 3 * first_target;
+          for (int t = 0; t < count; ++t) {
+            const double* e = entries.data() + 6 * t * stride + k;
+            const double xx = e[0], xy = e[stride], xz = e[2 * stride], yy = e[3 * stride],
+                         yz = e[4 * stride], zz = e[5 * stride];
+            double* b = col + 3 * t;  // the block's columns: (xx, xy, xz), (xy, yy, yz), (xz, yz, zz)
+            b[0] = xx, b[1] = xy, b[2] = xz;
+            b[ld] = xy, b[ld + 1] = yy, b[ld + 2] = yz;
+            b[2 * ld] = xz, b[2 * ld + 1] = yz, b[2 * ld + 2] = zz;
+          }
         }
       }
     }

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "stokesrods/common/assert.h"
+#include "stokesrods/solver/blas.h"
 
 namespace stokesrods {
 
@@ -133,6 +134,10 @@ bool CoarseLevel::Build(const std::vector<CoarseRod>& rods, const std::vector<Ma
         own_[r].block<3, 3>(3 * i, 3 * a) -= (scale * chunk_nodes_(b)) * StokesletMatrix(t);
       }
   }
+  // Applied in single precision with double sums (GemvRowsMixed): half the bytes per product.
+  own_single_.assign(rods.size(), Eigen::MatrixXf());
+  for (std::size_t r = 0; r < rods.size(); ++r) own_single_[r] = own_[r].cast<float>();
+  own_.clear();
   return regular;
 }
 
@@ -187,14 +192,16 @@ void CoarseLevel::ApplyW(const VecX& c, VecX* out) const {
   for (int b = 0; b < nc; ++b) strengths_.col(b) = (scale_ * chunk_nodes_(b)) * c.segment<3>(3 * b);
   between_->Apply(strengths_, &velocity_);  // every chunk, its own rod's too
   out->resize(3 * m);
-  const int num_rods = static_cast<int>(own_.size());
+  const int num_rods = static_cast<int>(own_single_.size());
 #pragma omp parallel for schedule(static) if (num_rods > 1)
   for (int r = 0; r < num_rods; ++r) {
     const int first = rod_first_node_[static_cast<size_t>(r)];
     const int n = rod_first_node_[static_cast<size_t>(r) + 1] - first;
     const int c0 = rod_first_chunk_[static_cast<size_t>(r)];
     const int chunks = rod_first_chunk_[static_cast<size_t>(r) + 1] - c0;
-    out->segment(3 * first, 3 * n) = own_[static_cast<size_t>(r)] * c.segment(3 * c0, 3 * chunks);
+    const Eigen::MatrixXf& own = own_single_[static_cast<size_t>(r)];
+    SR_ASSERT(own.cols() == 3 * chunks, "the coarse level's own block does not match its chunks");
+    GemvRowsMixed(own, 0, 3 * n, c.data() + 3 * c0, out->data() + 3 * first);
     for (int i = first; i < first + n; ++i) {
       Vec3 u = velocity_.col(i);
       for (int k = near_start_[static_cast<size_t>(i)]; k < near_start_[static_cast<size_t>(i) + 1]; ++k)
