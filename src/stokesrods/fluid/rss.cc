@@ -87,6 +87,8 @@ void AssembleRssMobility(const FluidParams& params, const std::vector<HydroRod>&
         }
         // Node k collects A_a of segment k and A_b of segment k − 1, times 1/(8πμ Δl_k): the
         // six entries per node, by rows over the nodes (vectorized), then written by columns.
+        // The end nodes have one segment; their "+ 0.0" (the missing one) keeps the bits of
+        // the sum as it was formed before, a zero's sign included.
         const double* w = node_scale[r].data();
         const auto stride = static_cast<size_t>(n) + 1;
         entries.resize(6 * stride * kChunk);
