@@ -2,10 +2,11 @@
 # parsed once per build instead of once per file, which took a third of each file's compile time
 # (docs/reliability.md, "The build on the AMD host"). Two headers only, each shared by
 # REUSE_FROM: one for the module libraries (position-independent code), one for the test programs
-# (position-independent executables); GCC uses a precompiled header only where the flags and macros it depends on are
-# those it was made with, and otherwise reads the headers as text (no other effect). Files with
-# flags of their own (an instruction set, -fno-math-errno) skip it. Clang (the fuzzer's build)
-# and STOKESRODS_PCH=OFF read every header as text, which also checks each file's own includes.
+# (position-independent executables); GCC uses a precompiled header only where the flags and
+# macros it depends on are those it was made with, and otherwise reads the headers as text (no
+# other effect). Files with flags of their own (an instruction set, -fno-math-errno) skip it.
+# Clang (the fuzzer's build) and STOKESRODS_PCH=OFF read every header as text, which also checks
+# each file's own includes.
 set(stokesrods_pch_common <vector> <string> <memory> <algorithm> <cmath> <Eigen/Core>
                           <Eigen/Geometry> <Eigen/LU>)
 

@@ -111,7 +111,8 @@ void AssembleRssMobility(const FluidParams& params, const std::vector<HydroRod>&
             const double* e = entries.data() + 6 * t * stride + k;
             const double xx = e[0], xy = e[stride], xz = e[2 * stride], yy = e[3 * stride],
                          yz = e[4 * stride], zz = e[5 * stride];
-            double* b = col + 3 * t;  // the block's columns: (xx, xy, xz), (xy, yy, yz), (xz, yz, zz)
+            // the block's columns: (xx, xy, xz), (xy, yy, yz), (xz, yz, zz)
+            double* b = col + 3 * t;
             b[0] = xx, b[1] = xy, b[2] = xz;
             b[ld] = xy, b[ld + 1] = yy, b[ld + 2] = yz;
             b[2 * ld] = xz, b[2 * ld + 1] = yz, b[2 * ld + 2] = zz;

@@ -75,14 +75,14 @@ bool CoarseLevel::Build(const std::vector<CoarseRod>& rods, const std::vector<Ma
   }
 
   // Within a rod: D_k Z_k, the block's columns summed over each chunk.
-  own_.assign(rods.size(), MatX());
+  std::vector<MatX> own(rods.size());  // in double until E is formed; own_ keeps it in single
   for (std::size_t r = 0; r < rods.size(); ++r) {
     const int first = rods[r].node_offset, n = static_cast<int>(rods[r].x->cols());
     const int c0 = rod_first_chunk_[r], chunks = rod_first_chunk_[r + 1] - c0;
-    own_[r].setZero(3 * n, 3 * chunks);
+    own[r].setZero(3 * n, 3 * chunks);
     for (int a = 0; a < chunks; ++a)
       for (int j = chunk_first_[static_cast<size_t>(c0 + a)]; j < chunk_first_[static_cast<size_t>(c0 + a) + 1]; ++j)
-        own_[r].middleCols<3>(3 * a) += blocks[r].middleCols<3>(3 * (j - first));
+        own[r].middleCols<3>(3 * a) += blocks[r].middleCols<3>(3 * (j - first));
   }
 
   // Between rods: the centroids' Stokeslets at the nodes (single precision, a preconditioner),
@@ -105,7 +105,7 @@ bool CoarseLevel::Build(const std::vector<CoarseRod>& rods, const std::vector<Ma
       if (rod_b == rod_a) {
         const int local = b - rod_first_chunk_[static_cast<size_t>(rod_a)];
         for (int i = begin; i < end; ++i)
-          e.block<3, 3>(3 * a, 3 * b) += own_[static_cast<size_t>(rod_a)].block<3, 3>(3 * (i - first), 3 * local);
+          e.block<3, 3>(3 * a, 3 * b) += own[static_cast<size_t>(rod_a)].block<3, 3>(3 * (i - first), 3 * local);
         continue;
       }
       double t[7];
@@ -119,8 +119,8 @@ bool CoarseLevel::Build(const std::vector<CoarseRod>& rods, const std::vector<Ma
   }
   const bool regular = lu_.Compute(e.cast<float>(), LuStorage::kHalf);
 
-  // between_ sums every chunk, the own rod's too: take the own centroids' Stokeslets out of own_
-  // (after E, which has the exact own blocks), so that W c = own_ c_k + between_.
+  // between_ sums every chunk, the own rod's too: take the own centroids' Stokeslets out of own
+  // (after E, which has the exact own blocks), so that W c = own c_k + between_.
   for (std::size_t r = 0; r < rods.size(); ++r) {
     const int first = rods[r].node_offset, n = static_cast<int>(rods[r].x->cols());
     const int c0 = rod_first_chunk_[r], chunks = rod_first_chunk_[r + 1] - c0;
@@ -131,13 +131,12 @@ bool CoarseLevel::Build(const std::vector<CoarseRod>& rods, const std::vector<Ma
         SumPointStokeslets(x.row(0).data() + first + i, x.row(1).data() + first + i,
                            x.row(2).data() + first + i, chunk_eps(b) * chunk_eps(b), 1,
                            centroids.col(b).data(), t);
-        own_[r].block<3, 3>(3 * i, 3 * a) -= (scale * chunk_nodes_(b)) * StokesletMatrix(t);
+        own[r].block<3, 3>(3 * i, 3 * a) -= (scale * chunk_nodes_(b)) * StokesletMatrix(t);
       }
   }
   // Applied in single precision with double sums (GemvRowsMixed): half the bytes per product.
-  own_single_.assign(rods.size(), Eigen::MatrixXf());
-  for (std::size_t r = 0; r < rods.size(); ++r) own_single_[r] = own_[r].cast<float>();
-  own_.clear();
+  own_.assign(rods.size(), Eigen::MatrixXf());
+  for (std::size_t r = 0; r < rods.size(); ++r) own_[r] = own[r].cast<float>();
   return regular;
 }
 
@@ -192,14 +191,14 @@ void CoarseLevel::ApplyW(const VecX& c, VecX* out) const {
   for (int b = 0; b < nc; ++b) strengths_.col(b) = (scale_ * chunk_nodes_(b)) * c.segment<3>(3 * b);
   between_->Apply(strengths_, &velocity_);  // every chunk, its own rod's too
   out->resize(3 * m);
-  const int num_rods = static_cast<int>(own_single_.size());
+  const int num_rods = static_cast<int>(own_.size());
 #pragma omp parallel for schedule(static) if (num_rods > 1)
   for (int r = 0; r < num_rods; ++r) {
     const int first = rod_first_node_[static_cast<size_t>(r)];
     const int n = rod_first_node_[static_cast<size_t>(r) + 1] - first;
     const int c0 = rod_first_chunk_[static_cast<size_t>(r)];
     const int chunks = rod_first_chunk_[static_cast<size_t>(r) + 1] - c0;
-    const Eigen::MatrixXf& own = own_single_[static_cast<size_t>(r)];
+    const Eigen::MatrixXf& own = own_[static_cast<size_t>(r)];
     SR_ASSERT(own.cols() == 3 * chunks, "the coarse level's own block does not match its chunks");
     GemvRowsMixed(own, 0, 3 * n, c.data() + 3 * c0, out->data() + 3 * first);
     for (int i = first; i < first + n; ++i) {

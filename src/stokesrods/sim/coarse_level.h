@@ -60,9 +60,9 @@ class CoarseLevel {
   std::vector<int> chunk_rod_;
   std::vector<int> rod_first_chunk_;  ///< per rod, and back() = chunks
   std::vector<int> rod_first_node_;   ///< per rod, and back() = M
-  std::vector<MatX> own_;          ///< per rod: D_k Z_k (3N_k × 3K_k) minus the Stokeslets of
-                                   ///< its own chunks' centroids (which between_ adds); in Build
-  std::vector<Eigen::MatrixXf> own_single_;  ///< the same in single precision, for ApplyW
+  /// Per rod: D_k Z_k (3N_k × 3K_k) minus the Stokeslets of its own chunks' centroids (which
+  /// between_ adds), in single precision (ApplyW sums in double: GemvRowsMixed).
+  std::vector<Eigen::MatrixXf> own_;
   VecX chunk_nodes_;               ///< N_b
   double scale_ = 0.0;
   std::unique_ptr<StokesletSum> between_;  ///< centroids → nodes

@@ -1,9 +1,9 @@
 // Spectral decompositions of dense matrices by LAPACK (OpenBLAS): the thin singular value
 // decomposition (dgesdd, divide and conquer) and the pseudo-inverse built on it, for the FMM's
 // translation operators; the eigenvalues of a general matrix (dgeev), for the explicit scheme's
-// stable step, and of a symmetric one (dsyevd), for the tests' spectra. Each is used once per run. Eigen's BDCSVD and EigenSolver do the same, but their
-// instantiations took 50–80 s of compile time per file under the sanitizers (docs/reliability.md,
-// "The build on the AMD host").
+// stable step, and of a symmetric one (dsyevd), for the tests' spectra. None runs in the time
+// step. Eigen's BDCSVD and EigenSolver do the same, but their instantiations took 50–80 s of
+// compile time per file under the sanitizers (docs/reliability.md, "The build on the AMD host").
 #pragma once
 
 #include <complex>
