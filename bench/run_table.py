@@ -61,20 +61,27 @@ def parse_args():
     args = p.parse_args()
     if args.repeat < 1:
         p.error("--repeat takes an integer ≥ 1")
-    args.cases = ALL_CASES if args.cases == "all" else [c for c in args.cases.split(",") if c]
-    unknown = [c for c in args.cases if c not in ALL_CASES]
-    if unknown:
-        p.error(f"unknown case(s) {', '.join(unknown)}; known: {', '.join(ALL_CASES)}")
-    try:
-        args.threads = [int(t) for t in args.threads.split(",") if t]
-    except ValueError:
-        p.error("--threads takes integers, e.g. 1,2")
-    if not args.threads or min(args.threads) < 1:
-        p.error("--threads takes integers ≥ 1")
+    args.cases, args.threads = parse_cases_and_threads(p, args.cases, args.threads)
     if not os.access(args.binary, os.X_OK):
         p.error(f"{args.binary} is not an executable: build it with "
                 "cmake --build --preset release --target bench_cases")
     return args
+
+
+def parse_cases_and_threads(p, cases, threads):
+    """--cases (comma-separated, or 'all') and --threads (comma-separated integers ≥ 1) as
+    lists; p.error on anything else."""
+    cases = ALL_CASES if cases == "all" else [c for c in cases.split(",") if c]
+    unknown = [c for c in cases if c not in ALL_CASES]
+    if unknown:
+        p.error(f"unknown case(s) {', '.join(unknown)}; known: {', '.join(ALL_CASES)}")
+    try:
+        threads = [int(t) for t in threads.split(",") if t]
+    except ValueError:
+        p.error("--threads takes integers, e.g. 1,2")
+    if not threads or min(threads) < 1:
+        p.error("--threads takes integers ≥ 1")
+    return cases, threads
 
 
 def read_first(path, key):
