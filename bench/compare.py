@@ -49,7 +49,8 @@ def parse_args():
                    help="configuration override for the candidate only (repeatable)")
     p.add_argument("--timeout", type=float, default=600.0, help="wall seconds per run")
     p.add_argument("--mem-limit-gb", type=float, default=8.0,
-                   help="address-space limit of each run (RLIMIT_AS)")
+                   help="address-space limit of each run (RLIMIT_AS), capped at the memory "
+                   "available minus 2 GB")
     p.add_argument("--json", metavar="OUT", help="write the raw results here")
     args = p.parse_args()
     if args.rounds < 1:
@@ -81,13 +82,11 @@ def summary(runs):
 
 def main():
     args = parse_args()
-    avail = run_table.mem_available_gb()
-    limit_gb = args.mem_limit_gb if avail is None else min(args.mem_limit_gb, max(1.0, avail - 2.0))
-    mem_limit = int(limit_gb * 2**30)
+    mem_limit = int(run_table.address_space_gb(args.mem_limit_gb) * 2**30)
     sides = {"baseline": side(args, args.baseline, []),
              "candidate": side(args, args.candidate, args.set_candidate)}
-    print(f"Machine: {run_table.machine()}")
-    print(f"Load average at start: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
+    print(run_table.describe_machine(run_table.machine()))
+    print(f"Load average at start: {run_table.load_text(os.getloadavg())}")
     print(f"baseline:  {args.baseline} {' '.join(args.set)}")
     print(f"candidate: {args.candidate} {' '.join(args.set + args.set_candidate)}")
     runs = {(c, t, s): [] for c in args.cases for t in args.threads for s in sides}
@@ -103,7 +102,7 @@ def main():
                         "failed: " + row.get("message", "")
                     print(f"  round {k + 1}/{args.rounds} {case} threads={threads} {name}: {ms}",
                           file=sys.stderr, flush=True)
-    print(f"Load average at end: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
+    print(f"Load average at end: {run_table.load_text(os.getloadavg())}")
     head = ["case", "threads", "baseline ms/step (median, range)",
             "candidate ms/step (median, range)", "candidate / baseline", "rounds' ratios",
             "Newton it./step", "GMRES products/step"]

@@ -120,6 +120,22 @@ def machine():
     }
 
 
+def describe_machine(info):
+    """The machine() line the scripts print first."""
+    return (f"Machine: {info['nproc']} CPUs ({info['cpu']}), {info['mem_total_gb']} GB "
+            f"({info['mem_available_gb']} GB available); {info['date']}; git {info['git']}")
+
+
+def load_text(load):
+    return " ".join(f"{l:.2f}" for l in load)
+
+
+def address_space_gb(requested_gb):
+    """The address-space limit of each run: as asked, at most the memory available minus 2 GB."""
+    avail = mem_available_gb() or requested_gb + 2.0
+    return max(0.1, min(requested_gb, avail - 2.0))
+
+
 def run_case(args, case, threads, mem_limit_bytes):
     """One process: its JSON line plus what the parent saw (wall time, exit, peak memory)."""
     warmup, timed = DEFAULT_STEPS.get(case, (DEFAULT_WARMUP, DEFAULT_TIMED))
@@ -312,12 +328,10 @@ def scaling(rows, threads_list, rounds=None):
 def main():
     args = parse_args()
     info = machine()
-    avail = mem_available_gb() or args.mem_limit_gb + 2.0
-    mem_limit_gb = max(0.1, min(args.mem_limit_gb, avail - 2.0))
+    mem_limit_gb = address_space_gb(args.mem_limit_gb)
     load_start = os.getloadavg()
-    print(f"Machine: {info['nproc']} CPUs ({info['cpu']}), {info['mem_total_gb']} GB "
-          f"({info['mem_available_gb']} GB available); {info['date']}; git {info['git']}")
-    print(f"Load average at start: {' '.join(f'{l:.2f}' for l in load_start)}")
+    print(describe_machine(info))
+    print(f"Load average at start: {load_text(load_start)}")
     print(f"Per case: timeout {args.timeout:g} s, address space {mem_limit_gb:.1f} GB; "
           f"binary {args.binary}" + (f"; --set {' '.join(args.set)}" if args.set else ""))
     sys.stdout.flush()
@@ -339,7 +353,7 @@ def main():
     rows = median_rows(rounds) if args.repeat > 1 else rounds[0]
     load_end = os.getloadavg()
 
-    print(f"Load average at end: {' '.join(f'{l:.2f}' for l in load_end)}")
+    print(f"Load average at end: {load_text(load_end)}")
     cores = sorted({r["blas_core"] for r in rows if r.get("blas_core")})
     if cores:
         print(f"OpenBLAS kernels: {', '.join(cores)}")
