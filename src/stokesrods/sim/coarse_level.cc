@@ -11,27 +11,10 @@ namespace stokesrods {
 
 namespace {
 
-// t = Σ_j over n points of (1/R + ε²/R³, then r rᵀ/R³ as xx, xy, xz, yy, yz, zz), r = p − x_j,
-// R² = |r|² + ε²: the point Stokeslets S_ε between p and a chunk of nodes, summed.
-__attribute__((target_clones("avx512f", "avx2", "default")))
-void SumPointStokeslets(const double* xs, const double* ys, const double* zs, double e2, int n,
-                        const double* p, double t[7]) {
-  const double px = p[0], py = p[1], pz = p[2];
-  double diag = 0, sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0;
-#pragma omp simd reduction(+ : diag, sxx, sxy, sxz, syy, syz, szz)
-  for (int j = 0; j < n; ++j) {
-    const double rx = px - xs[j], ry = py - ys[j], rz = pz - zs[j];
-    const double inv = 1.0 / std::sqrt(rx * rx + ry * ry + rz * rz + e2);
-    const double inv3 = inv * inv * inv;
-    diag += inv + e2 * inv3;
-    sxx += rx * rx * inv3, sxy += rx * ry * inv3, sxz += rx * rz * inv3;
-    syy += ry * ry * inv3, syz += ry * rz * inv3, szz += rz * rz * inv3;
-  }
-  t[0] = diag, t[1] = sxx, t[2] = sxy, t[3] = sxz, t[4] = syy, t[5] = syz, t[6] = szz;
-}
-
-// t[k np + j], k < 7: SumPointStokeslets' sums over the n nodes (xs, ys, zs) at each of the np
-// points (px, py, pz) with its own ε² (e2), all points at once.
+// t[k np + j], k < 7: over the n nodes (xs, ys, zs), Σ_i of (1/R + ε²/R³, then r rᵀ/R³ as xx,
+// xy, xz, yy, yz, zz), r = p_j − x_i, R² = |r|² + ε_j², at each of the np points p_j = (px, py,
+// pz)_j with its own ε_j² (e2): the point Stokeslets S_ε between a chunk of nodes and each point,
+// summed over the chunk, all points at once (vectorized over the points).
 __attribute__((target_clones("avx512f", "avx2", "default")))
 void SumChunkAtPoints(const double* xs, const double* ys, const double* zs, int n,
                       const double* px, const double* py, const double* pz, const double* e2,
@@ -49,6 +32,12 @@ void SumChunkAtPoints(const double* xs, const double* ys, const double* zs, int 
       t[4 * np + j] += ry * ry * inv3, t[5 * np + j] += ry * rz * inv3, t[6 * np + j] += rz * rz * inv3;
     }
   }
+}
+
+// The same at one point p (x, y, z) with ε² = e2.
+void SumPointStokeslets(const double* xs, const double* ys, const double* zs, double e2, int n,
+                        const double* p, double t[7]) {
+  SumChunkAtPoints(xs, ys, zs, n, p, p + 1, p + 2, &e2, 1, t);
 }
 
 // e's 3 × 3 block (3a, 3b) = m, in single precision (written out: Eigen's cast into a block of
@@ -134,7 +123,7 @@ bool CoarseLevel::Build(const std::vector<CoarseRod>& rods, const std::vector<Ma
   const VecX chunk_e2 = chunk_eps.cwiseProduct(chunk_eps);
 #pragma omp parallel
   {
-    MatX sums(nc, 7);  // per centroid b, SumPointStokeslets' seven sums over a's nodes
+    MatX sums(nc, 7);  // per centroid b, the seven sums over a's nodes
 #pragma omp for schedule(dynamic, 4)
     for (int a = 0; a < nc; ++a) {
       const int rod_a = chunk_rod_[static_cast<size_t>(a)];
