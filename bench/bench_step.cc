@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <random>
 
@@ -14,6 +15,7 @@
 #include "stokesrods/fluid/mobility_reuse_half.h"
 #include "stokesrods/io/build_model.h"
 #include "stokesrods/io/config.h"
+#include "stokesrods/sim/coarse_level.h"
 #include "stokesrods/sim/elastic_assembly.h"
 #include "stokesrods/sim/hydro_coupling.h"
 #include "stokesrods/sim/integrator.h"
@@ -326,6 +328,45 @@ void BM_SegmentClosestPoints(benchmark::State& st) {
   }
 }
 BENCHMARK(BM_SegmentClosestPoints);
+
+// The coarse level of the preconditioner (sim/coarse_level.h) on a lattice of helices 4 cm apart
+// (10 = 2 × 5, 20 = 4 × 5, 50 = 5 × 10), with random diagonally dominant per-rod blocks: one
+// application as CapacitancePreconditioner::Apply makes it (c = E⁻¹ Zᵀ v, W c, Z c). Arguments:
+// helices; the layout, 0 eight chunks of forces, 1 four chunks of forces and turns at four points
+// each. Counter build_ms: one Build.
+void BM_CoarseLevelApply(benchmark::State& st) {
+  const int helices = static_cast<int>(st.range(0)), rows = helices == 10 ? 2 : helices == 20 ? 4 : 5;
+  const Matrix3X all = testing::HelixLattice(rows, helices / rows).targets;
+  constexpr int kNodes = 65;
+  std::vector<Matrix3X> x;
+  std::vector<MatX> blocks;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal;
+  for (int r = 0; r < helices; ++r) {
+    x.push_back(all.middleCols(r * kNodes, kNodes));
+    blocks.push_back(MatX::NullaryExpr(3 * kNodes, 3 * kNodes, [&]() { return normal(rng); }) +
+                     50.0 * MatX::Identity(3 * kNodes, 3 * kNodes));
+  }
+  std::vector<CoarseRod> rods;
+  for (int r = 0; r < helices; ++r) rods.push_back({.x = &x[static_cast<size_t>(r)], .eps = 1.02e-3, .node_offset = r * kNodes});
+  const CoarseLayout layout = st.range(1) == 0 ? CoarseLayout{}
+                                               : CoarseLayout{.chunks_per_rod = 4, .turns = true, .points_per_chunk = 4};
+  CoarseLevel coarse;
+  const auto start = std::chrono::steady_clock::now();
+  coarse.Build(rods, blocks, 0.37, layout);
+  st.counters["build_ms"] =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const VecX v = VecX::NullaryExpr(3 * kNodes * helices, [&]() { return normal(rng); });
+  VecX wc, y;
+  for (auto _ : st) {
+    const VecX c = coarse.Solve(v);
+    coarse.ApplyW(c, &wc);
+    y = v - wc;
+    coarse.AddZ(c, &y);
+    benchmark::DoNotOptimize(y.data());
+  }
+}
+BENCHMARK(BM_CoarseLevelApply)->ArgsProduct({{10, 20, 50}, {0, 1}})->Unit(benchmark::kMicrosecond);
 
 // Whole steps from a state already in motion (the first 20 steps are not timed).
 void StepBenchmark(benchmark::State& st, int rods, int nodes, const std::string& fluid,

@@ -1,11 +1,14 @@
 // The coarse level of the two-level preconditioner (sim/coarse_level.h) on a 2 × 3 lattice of
-// helices (tests/common/helix_lattice.h, 65 nodes each, 4 cm apart):
-//   - W c against W assembled here the straightforward way (own blocks, node-to-node Stokeslets
-//     near a chunk, the centroid's Stokeslet beyond) for random c;
+// helices (tests/common/helix_lattice.h, 65 nodes each, moved to 2.4 cm apart so that some nodes
+// lie near another rod's points), in both layouts (eight chunks of forces at their centroids;
+// four chunks of forces and turns, four points each):
+//   - W c against W assembled here the straightforward way (own blocks times the modes, each
+//     chunk's points' Stokeslets carrying their nodes' forces, the nodes' own near a point) for
+//     random c, with the near corrections taking part;
 //   - E = Zᵀ W (E is what the coarse solve inverts: c = E⁻¹ Zᵀ v must solve Zᵀ W c = Zᵀ v, to
-//     the backward error of its single-precision LU);
-//   - the centroid approximation against the node-to-node W it replaced (every node's point
-//     Stokeslet): the error of a chunk's monopole at ≥ 2 chunk radii is its quadrupole, O((a/d)²).
+//     the backward error of its half-precision LU), and Z c;
+//   - the points' approximation against the node-to-node W (every node's point Stokeslet): the
+//     error of a point's monopole at ≥ 2 radii is its quadrupole, O((a/d)²).
 #include "stokesrods/sim/coarse_level.h"
 
 #include <gtest/gtest.h>
@@ -13,6 +16,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <string>
 
 #include "common/helix_lattice.h"
 #include "stokesrods/solver/dense_spectral.h"
@@ -42,7 +46,10 @@ Lattice MakeLattice() {
   std::normal_distribution<double> normal;
   const int num_rods = static_cast<int>(all.cols()) / kNodes;
   for (int r = 0; r < num_rods; ++r) {
-    l.x.push_back(all.middleCols(r * kNodes, kNodes));
+    // Moved to 2.4 cm apart (a 4 mm gap between the helices): some nodes then lie near another
+    // rod's points, so that W's near corrections are part of what the tests compare.
+    const Vec3 shift(-0.4 * 0.04 * (r / 3), -0.4 * 0.04 * (r % 3), 0.0);
+    l.x.push_back(all.middleCols(r * kNodes, kNodes).colwise() + shift);
     MatX d = MatX::NullaryExpr(3 * kNodes, 3 * kNodes, [&]() { return normal(rng); });
     l.blocks.push_back(d + 50.0 * MatX::Identity(3 * kNodes, 3 * kNodes));
   }
@@ -50,57 +57,102 @@ Lattice MakeLattice() {
   return l;
 }
 
-// The chunks of rod r as CoarseLevel makes them: [first + a n / K, first + (a + 1) n / K).
-int ChunkBegin(int r, int a) { return r * kNodes + a * kNodes / CoarseLevel::kChunksPerRod; }
+Vec3 Node(const Lattice& l, int i) { return l.x[static_cast<size_t>(i / kNodes)].col(i % kNodes); }
 
-// W (3M × 3 chunks) column by column; node_to_node: every node's Stokeslet between rods (the W
-// of before); otherwise the definition of coarse_level.h.
-MatX ReferenceW(const Lattice& l, bool node_to_node) {
-  const int rods = static_cast<int>(l.x.size()), k = CoarseLevel::kChunksPerRod, m = rods * kNodes;
-  MatX w = MatX::Zero(3 * m, 3 * rods * k);
+Vec3 Centroid(const Lattice& l, int begin, int end) {
+  Vec3 c = Vec3::Zero();
+  for (int j = begin; j < end; ++j) c += Node(l, j);
+  return c / static_cast<double>(end - begin);
+}
+
+// The coarse space of one layout, written out as coarse_level.h defines it.
+struct Space {
+  CoarseLayout layout;
+  int chunks() const { return layout.chunks_per_rod; }
+  int modes() const { return layout.modes(); }
+  // The chunks of rod r as CoarseLevel makes them: [first + a n / K, first + (a + 1) n / K).
+  int ChunkBegin(int r, int a) const { return r * kNodes + a * kNodes / chunks(); }
+  int ChunkEnd(int r, int a) const { return a + 1 < chunks() ? ChunkBegin(r, a + 1) : (r + 1) * kNodes; }
+  // Z at d from the chunk's centroid: the nodal force F (+ Ω × d) of the modes.
+  MatX Modes(const Vec3& d) const {
+    MatX z = MatX::Zero(3, modes());
+    z.leftCols<3>() = Mat3::Identity();
+    if (layout.turns)
+      for (int k = 0; k < 3; ++k) z.col(3 + k) = Vec3::Unit(k).cross(d);
+    return z;
+  }
+};
+
+// W (3M × modes × chunks) column by column; node_to_node: every node's Stokeslet between rods;
+// otherwise the definition of coarse_level.h (each point's Stokeslet at its centroid carrying its
+// nodes' forces, its nodes' own near it). near_blocks: how many (node, point) pairs were near.
+MatX ReferenceW(const Lattice& l, const Space& z, bool node_to_node, int* near_blocks = nullptr) {
+  if (near_blocks) *near_blocks = 0;
+  const int rods = static_cast<int>(l.x.size()), m = rods * kNodes, modes = z.modes();
+  const int points = z.layout.points_per_chunk;
+  MatX w = MatX::Zero(3 * m, modes * rods * z.chunks());
   for (int rb = 0; rb < rods; ++rb)
-    for (int a = 0; a < k; ++a) {
-      const int b = rb * k + a, begin = ChunkBegin(rb, a), end = a + 1 < k ? ChunkBegin(rb, a + 1) : (rb + 1) * kNodes;
-      Matrix3X chunk(3, end - begin);
-      for (int j = begin; j < end; ++j) chunk.col(j - begin) = l.x[static_cast<size_t>(rb)].col(j - rb * kNodes);
-      const Vec3 centroid = chunk.rowwise().mean();
-      double radius = 0.0;
-      for (int j = 0; j < chunk.cols(); ++j) radius = std::max(radius, (chunk.col(j) - centroid).norm());
+    for (int a = 0; a < z.chunks(); ++a) {
+      const int b = rb * z.chunks() + a, begin = z.ChunkBegin(rb, a), end = z.ChunkEnd(rb, a);
+      const Vec3 centroid = Centroid(l, begin, end);
       for (int i = 0; i < m; ++i) {
         const int ri = i / kNodes;
-        const Vec3 p = l.x[static_cast<size_t>(ri)].col(i % kNodes);
-        Mat3 block = Mat3::Zero();
+        const Vec3 p = Node(l, i);
+        MatX block = MatX::Zero(3, modes);
         if (ri == rb) {
           for (int j = begin; j < end; ++j)
-            block += l.blocks[static_cast<size_t>(ri)].block<3, 3>(3 * (i % kNodes), 3 * (j - rb * kNodes));
-        } else if (node_to_node || (p - centroid).norm() < 2.0 * radius) {
-          for (int j = 0; j < chunk.cols(); ++j) block += kScale * Stokeslet(p - chunk.col(j), kEps);
+            block += l.blocks[static_cast<size_t>(ri)].block<3, 3>(3 * (i % kNodes), 3 * (j - rb * kNodes)) *
+                     z.Modes(Node(l, j) - centroid);
+        } else if (node_to_node) {
+          for (int j = begin; j < end; ++j)
+            block += kScale * Stokeslet(p - Node(l, j), kEps) * z.Modes(Node(l, j) - centroid);
         } else {
-          block = kScale * static_cast<double>(chunk.cols()) * Stokeslet(p - centroid, kEps);
+          for (int q = 0; q < points; ++q) {
+            const int p0 = begin + q * (end - begin) / points, p1 = begin + (q + 1) * (end - begin) / points;
+            const Vec3 y = Centroid(l, p0, p1);
+            double radius = 0.0;
+            for (int j = p0; j < p1; ++j) radius = std::max(radius, (Node(l, j) - y).norm());
+            if ((p - y).norm() < 2.0 * radius) {
+              if (near_blocks) ++*near_blocks;
+              for (int j = p0; j < p1; ++j)
+                block += kScale * Stokeslet(p - Node(l, j), kEps) * z.Modes(Node(l, j) - centroid);
+            } else {
+              block += kScale * static_cast<double>(p1 - p0) * Stokeslet(p - y, kEps) * z.Modes(y - centroid);
+            }
+          }
         }
-        w.block<3, 3>(3 * i, 3 * b) = block;
+        w.block(3 * i, modes * b, 3, modes) = block;
       }
     }
   return w;
 }
 
-MatX ZTranspose(int rods, const MatX& w) {  // rows summed over each chunk
-  const int k = CoarseLevel::kChunksPerRod;
-  MatX z = MatX::Zero(3 * rods * k, w.cols());
+// Zᵀ w: per chunk, w's rows summed (forces) and their moments Σ d_i × w_i (turns).
+MatX ZTranspose(const Lattice& l, const Space& z, const MatX& w) {
+  const int rods = static_cast<int>(l.x.size()), modes = z.modes();
+  MatX out = MatX::Zero(modes * rods * z.chunks(), w.cols());
   for (int r = 0; r < rods; ++r)
-    for (int a = 0; a < k; ++a) {
-      const int end = a + 1 < k ? ChunkBegin(r, a + 1) : (r + 1) * kNodes;
-      for (int i = ChunkBegin(r, a); i < end; ++i) z.middleRows<3>(3 * (r * k + a)) += w.middleRows<3>(3 * i);
+    for (int a = 0; a < z.chunks(); ++a) {
+      const Vec3 centroid = Centroid(l, z.ChunkBegin(r, a), z.ChunkEnd(r, a));
+      for (int i = z.ChunkBegin(r, a); i < z.ChunkEnd(r, a); ++i)
+        out.middleRows(modes * (r * z.chunks() + a), modes) +=
+            z.Modes(Node(l, i) - centroid).transpose() * w.middleRows<3>(3 * i);
     }
-  return z;
+  return out;
 }
 
-TEST(CoarseLevel, ProductMatchesTheAssembledW) {
+class CoarseLevelLayout : public ::testing::TestWithParam<CoarseLayout> {};
+
+TEST_P(CoarseLevelLayout, ProductMatchesTheAssembledW) {
   const Lattice l = MakeLattice();
+  const Space z{GetParam()};
   CoarseLevel coarse;
-  ASSERT_TRUE(coarse.Build(l.rods, l.blocks, kScale));
-  ASSERT_EQ(coarse.num_chunks(), 6 * CoarseLevel::kChunksPerRod);
-  const MatX w = ReferenceW(l, false);
+  ASSERT_TRUE(coarse.Build(l.rods, l.blocks, kScale, z.layout));
+  ASSERT_EQ(coarse.num_chunks(), 6 * z.chunks());
+  int near_blocks = 0;
+  const MatX w = ReferenceW(l, z, false, &near_blocks);
+  std::printf("  nodes near a point of another rod: %d\n", near_blocks);
+  ASSERT_GT(near_blocks, 0);  // the near corrections are part of what is compared
   std::mt19937 rng(3);
   std::normal_distribution<double> normal;
   for (int trial = 0; trial < 3; ++trial) {
@@ -112,22 +164,23 @@ TEST(CoarseLevel, ProductMatchesTheAssembledW) {
   }
 }
 
-TEST(CoarseLevel, SolveInvertsZTransposeW) {
+TEST_P(CoarseLevelLayout, SolveInvertsZTransposeW) {
   const Lattice l = MakeLattice();
+  const Space z{GetParam()};
   CoarseLevel coarse;
-  ASSERT_TRUE(coarse.Build(l.rods, l.blocks, kScale));
-  const MatX ztw = ZTranspose(6, ReferenceW(l, false));
+  ASSERT_TRUE(coarse.Build(l.rods, l.blocks, kScale, z.layout));
+  const MatX w = ReferenceW(l, z, false);
+  const MatX ztw = ZTranspose(l, z, w);
   std::mt19937 rng(5);
   std::normal_distribution<double> normal;
-  const VecX v = VecX::NullaryExpr(ReferenceW(l, false).rows(), [&]() { return normal(rng); });
+  const VecX v = VecX::NullaryExpr(w.rows(), [&]() { return normal(rng); });
   const VecX c = coarse.Solve(v);
-  const VecX ztv = ZTranspose(6, v);
+  const VecX ztv = ZTranspose(l, z, v);
   // E's LU factors are kept in half precision (DenseLu kHalf, where the CPU allows it, else in
   // single): rounding them perturbs E by at most u |L||U| entrywise, u = 2⁻¹¹ (4.9e-4), which
   // partial pivoting keeps near u ‖E‖ (the factorization's own single-precision error is 500×
-  // smaller). Residual within 2 u ‖E‖₂ ‖c‖ (measured 0.13 u ‖E‖₂ ‖c‖, which E's conditioning
-  // makes 1.1 % of ‖Zᵀv‖; below 7e-4 of it with single-precision factors, the bound of before);
-  // an E inconsistent with W would miss by O(‖Zᵀv‖).
+  // smaller). Residual within 2 u ‖E‖₂ ‖c‖ (measured 0.13 u ‖E‖₂ ‖c‖ with forces alone, which
+  // E's conditioning makes 1.1 % of ‖Zᵀv‖); an E inconsistent with W would miss by O(‖Zᵀv‖).
   MatX u_svd, v_svd;
   VecX sigma;
   ASSERT_TRUE(ThinSvd(ztw, &u_svd, &sigma, &v_svd));
@@ -138,24 +191,43 @@ TEST(CoarseLevel, SolveInvertsZTransposeW) {
   EXPECT_LT(residual, 2.0 * 4.9e-4 * norm_e * c.norm());
   EXPECT_LT(residual, 0.05 * ztv.norm());
   VecX y = VecX::Zero(v.size());
-  coarse.AddZ(c, &y);  // Z c: each node takes its chunk's c
-  EXPECT_EQ(y.segment<3>(3 * (kNodes + 1)), c.segment<3>(3 * CoarseLevel::kChunksPerRod));
+  coarse.AddZ(c, &y);  // Z c: each node takes its chunk's force (and turn), F + Ω × (x_i − X_b)
+  const int node = kNodes + 1, chunk = z.chunks();  // rod 1's second node, in its first chunk
+  const Vec3 d = Node(l, node) - Centroid(l, z.ChunkBegin(1, 0), z.ChunkEnd(1, 0));
+  const VecX mine = c.segment(z.modes() * chunk, z.modes());
+  EXPECT_LT((y.segment<3>(3 * node) - z.Modes(d) * mine).norm(), 1e-12 * mine.norm());
 }
 
-TEST(CoarseLevel, CentroidsApproximateTheNodeToNodeCoupling) {
+TEST_P(CoarseLevelLayout, PointsApproximateTheNodeToNodeCoupling) {
   const Lattice l = MakeLattice();
-  const MatX mine = ReferenceW(l, false), node_to_node = ReferenceW(l, true);
-  // Between rods, block by block: beyond 2 chunk radii the monopole's error is the quadrupole's,
-  // ≲ (a/d)² ≤ 1/4 of the block (measured here: see the printout).
+  const Space z{GetParam()};
+  const MatX mine = ReferenceW(l, z, false), node_to_node = ReferenceW(l, z, true);
+  // Between rods, block by block (3 × modes): beyond 2 radii of a point its monopole's error is
+  // the quadrupole's, ≲ (a/d)² ≤ 1/4 of the block (measured here: see the printout).
   double worst = 0.0;
+  const int modes = z.modes();
   for (Eigen::Index i = 0; i < mine.rows() / 3; ++i)
-    for (Eigen::Index b = 0; b < mine.cols() / 3; ++b) {
-      if (i / kNodes == b / CoarseLevel::kChunksPerRod) continue;
-      const Mat3 ref = node_to_node.block<3, 3>(3 * i, 3 * b);
-      worst = std::max(worst, (mine.block<3, 3>(3 * i, 3 * b) - ref).norm() / ref.norm());
+    for (Eigen::Index b = 0; b < mine.cols() / modes; ++b) {
+      if (i / kNodes == b / z.chunks()) continue;
+      const MatX ref = node_to_node.block(3 * i, modes * b, 3, modes);
+      worst = std::max(worst, (mine.block(3 * i, modes * b, 3, modes) - ref).norm() / ref.norm());
     }
   std::printf("worst relative error of a between-rod block: %.3f\n", worst);
   EXPECT_LT(worst, 0.25);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Layouts, CoarseLevelLayout,
+    ::testing::Values(CoarseLayout{},  // eight chunks of forces at their centroids
+                      CoarseLayout{.chunks_per_rod = 4, .turns = true, .points_per_chunk = 4}),
+    [](const ::testing::TestParamInfo<CoarseLayout>& param) {
+      return std::string(param.param.turns ? "ForcesAndTurns" : "Forces");
+    });
+
+TEST(CoarseLevel, LayoutBySize) {  // turns for a few tens of rods, forces alone beyond
+  EXPECT_TRUE(CoarseLayout::For(10).turns);
+  EXPECT_TRUE(CoarseLayout::For(CoarseLayout::kTurnsUpToRods).turns);
+  EXPECT_FALSE(CoarseLayout::For(CoarseLayout::kTurnsUpToRods + 1).turns);
 }
 
 }  // namespace

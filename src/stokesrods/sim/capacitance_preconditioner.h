@@ -18,8 +18,8 @@
 //     swimming cell's body, flagella, the flow between them and its motion are one exact block
 //     (without the flow between a body and its own flagella GMRES needed 3.5× more products:
 //     docs/performance.md).
-//   Coarse level (optional, sim/coarse_level.h): per rod, 4 chunks of consecutive nodes with a
-//     uniform force each (columns Z), E = Zᵀ W with W ≈ C Z on the rods' rows (zero on the
+//   Coarse level (optional, sim/coarse_level.h): per rod, chunks of consecutive nodes with a
+//     force (and a turn) each (columns Z), E = Zᵀ W with W ≈ C Z on the rods' rows (zero on the
 //     bodies' and their motions' rows). One application: c = E⁻¹ Zᵀ r,
 //     y = Z c + Fine⁻¹ (r − W c). Block Jacobi alone misses the collective flow of many rods
 //     (GMRES then needs 5–6× more products).

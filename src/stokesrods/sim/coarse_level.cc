@@ -14,38 +14,71 @@ namespace {
 // t[k np + j], k < 7: over the n nodes (xs, ys, zs), Σ_i of (1/R + ε²/R³, then r rᵀ/R³ as xx,
 // xy, xz, yy, yz, zz), r = p_j − x_i, R² = |r|² + ε_j², at each of the np points p_j = (px, py,
 // pz)_j with its own ε_j² (e2): the point Stokeslets S_ε between a chunk of nodes and each point,
-// summed over the chunk, all points at once (vectorized over the points).
+// summed over the chunk, all points at once (vectorized over the points). With a centre c (not
+// null), also their first moments about it, t[(7 + 7 a + k) np + j] = Σ_i (x_i − c)_a (the k-th
+// term), a < 3, summed over spans of kSpan points whose 28 sums stay in L1 while every node
+// passes over them (all 320 points of twenty helices at once, 72 KB swept once per node, took
+// E 13–14 ms against 1.5 ms for the 7 sums).
 __attribute__((target_clones("avx512f", "avx2", "default")))
 void SumChunkAtPoints(const double* xs, const double* ys, const double* zs, int n,
                       const double* px, const double* py, const double* pz, const double* e2,
-                      int np, double* t) {
-  std::fill(t, t + 7 * static_cast<std::ptrdiff_t>(np), 0.0);
-  for (int i = 0; i < n; ++i) {
-    const double x = xs[i], y = ys[i], z = zs[i];
+                      int np, const double* centre, double* t) {
+  if (centre == nullptr) {
+    std::fill(t, t + 7 * static_cast<std::ptrdiff_t>(np), 0.0);
+    for (int i = 0; i < n; ++i) {
+      const double x = xs[i], y = ys[i], z = zs[i];
 #pragma omp simd
-    for (int j = 0; j < np; ++j) {
-      const double rx = px[j] - x, ry = py[j] - y, rz = pz[j] - z;
-      const double inv = 1.0 / std::sqrt(rx * rx + ry * ry + rz * rz + e2[j]);
-      const double inv3 = inv * inv * inv;
-      t[j] += inv + e2[j] * inv3;
-      t[np + j] += rx * rx * inv3, t[2 * np + j] += rx * ry * inv3, t[3 * np + j] += rx * rz * inv3;
-      t[4 * np + j] += ry * ry * inv3, t[5 * np + j] += ry * rz * inv3, t[6 * np + j] += rz * rz * inv3;
+      for (int j = 0; j < np; ++j) {
+        const double rx = px[j] - x, ry = py[j] - y, rz = pz[j] - z;
+        const double inv = 1.0 / std::sqrt(rx * rx + ry * ry + rz * rz + e2[j]);
+        const double inv3 = inv * inv * inv;
+        t[j] += inv + e2[j] * inv3;
+        t[np + j] += rx * rx * inv3, t[2 * np + j] += rx * ry * inv3, t[3 * np + j] += rx * rz * inv3;
+        t[4 * np + j] += ry * ry * inv3, t[5 * np + j] += ry * rz * inv3, t[6 * np + j] += rz * rz * inv3;
+      }
     }
+    return;
+  }
+  constexpr int kSpan = 64;  // points per span: 28 sums of 64 points, 14 KB
+  double s[28 * kSpan];
+  for (int j0 = 0; j0 < np; j0 += kSpan) {
+    const int ns = std::min(kSpan, np - j0);
+    std::fill(s, s + 28 * kSpan, 0.0);
+    for (int i = 0; i < n; ++i) {
+      const double x = xs[i], y = ys[i], z = zs[i];
+      const double dx = x - centre[0], dy = y - centre[1], dz = z - centre[2];
+#pragma omp simd
+      for (int j = 0; j < ns; ++j) {
+        const double rx = px[j0 + j] - x, ry = py[j0 + j] - y, rz = pz[j0 + j] - z;
+        const double inv = 1.0 / std::sqrt(rx * rx + ry * ry + rz * rz + e2[j0 + j]);
+        const double inv3 = inv * inv * inv;
+        // Written out term by term (with the terms in an array the loop stayed scalar).
+        const double v0 = inv + e2[j0 + j] * inv3, v1 = rx * rx * inv3, v2 = rx * ry * inv3,
+                     v3 = rx * rz * inv3, v4 = ry * ry * inv3, v5 = ry * rz * inv3,
+                     v6 = rz * rz * inv3;
+        double* q = s + j;
+        q[0 * kSpan] += v0, q[1 * kSpan] += v1, q[2 * kSpan] += v2, q[3 * kSpan] += v3;
+        q[4 * kSpan] += v4, q[5 * kSpan] += v5, q[6 * kSpan] += v6;
+        q[7 * kSpan] += dx * v0, q[8 * kSpan] += dx * v1, q[9 * kSpan] += dx * v2;
+        q[10 * kSpan] += dx * v3, q[11 * kSpan] += dx * v4, q[12 * kSpan] += dx * v5;
+        q[13 * kSpan] += dx * v6;
+        q[14 * kSpan] += dy * v0, q[15 * kSpan] += dy * v1, q[16 * kSpan] += dy * v2;
+        q[17 * kSpan] += dy * v3, q[18 * kSpan] += dy * v4, q[19 * kSpan] += dy * v5;
+        q[20 * kSpan] += dy * v6;
+        q[21 * kSpan] += dz * v0, q[22 * kSpan] += dz * v1, q[23 * kSpan] += dz * v2;
+        q[24 * kSpan] += dz * v3, q[25 * kSpan] += dz * v4, q[26 * kSpan] += dz * v5;
+        q[27 * kSpan] += dz * v6;
+      }
+    }
+    for (int k = 0; k < 28; ++k)
+      std::copy(s + k * kSpan, s + k * kSpan + ns, t + k * static_cast<std::ptrdiff_t>(np) + j0);
   }
 }
 
 // The same at one point p (x, y, z) with ε² = e2.
 void SumPointStokeslets(const double* xs, const double* ys, const double* zs, double e2, int n,
                         const double* p, double t[7]) {
-  SumChunkAtPoints(xs, ys, zs, n, p, p + 1, p + 2, &e2, 1, t);
-}
-
-// e's 3 × 3 block (3a, 3b) = m, in single precision (written out: Eigen's cast into a block of
-// a column-major float matrix was slower, E of a hundred helices 44–60 against 35–43 ms).
-void PutBlock(const Mat3& m, int a, int b, Eigen::MatrixXf* e) {
-  float* column = e->data() + 3 * static_cast<std::ptrdiff_t>(b) * e->rows() + 3 * a;
-  for (int c = 0; c < 3; ++c, column += e->rows())
-    for (int r = 0; r < 3; ++r) column[r] = static_cast<float>(m(r, c));
+  SumChunkAtPoints(xs, ys, zs, n, p, p + 1, p + 2, &e2, 1, nullptr, t);
 }
 
 Mat3 StokesletMatrix(const double t[7]) {
@@ -54,76 +87,161 @@ Mat3 StokesletMatrix(const double t[7]) {
   return s;
 }
 
+// [d]×, the cross product's matrix: [d]× v = d × v.
+Mat3 Cross(const Vec3& d) {
+  Mat3 k;
+  k << 0.0, -d.z(), d.y(), d.z(), 0.0, -d.x(), -d.y(), d.x(), 0.0;
+  return k;
+}
+
+// Z at a node d from its chunk's centroid, 3 × K: [I] (K = 3) or [I, −[d]×] (K = 6: the nodal
+// force F + Ω × d = F − [d]× Ω).
+template <int K>
+Eigen::Matrix<double, 3, K> ModesAt(const Vec3& d) {
+  Eigen::Matrix<double, 3, K> z;
+  z.template leftCols<3>().setIdentity();
+  if constexpr (K == 6) z.template rightCols<3>() = -Cross(d);
+  return z;
+}
+
+// Zᵀ b for a node d from its chunk's centroid (K × b's columns): b, or [b; [d]× b].
+template <int K, class B>
+Eigen::Matrix<double, K, B::ColsAtCompileTime> ModesTransposedTimes(const Vec3& d, const B& b) {
+  if constexpr (K == 3) {
+    return b;
+  } else {
+    Eigen::Matrix<double, K, B::ColsAtCompileTime> out;
+    out << b, Cross(d) * b;
+    return out;
+  }
+}
+
+// e's K × K block (K a, K b) = m, in single precision (written out: Eigen's cast into a block of
+// a column-major float matrix was slower, E of a hundred helices 44–60 against 35–43 ms).
+template <int K>
+void PutBlock(const Eigen::Matrix<double, K, K>& m, int a, int b, Eigen::MatrixXf* e) {
+  float* column = e->data() + static_cast<std::ptrdiff_t>(K) * b * e->rows() + K * a;
+  for (int c = 0; c < K; ++c, column += e->rows())
+    for (int r = 0; r < K; ++r) column[r] = static_cast<float>(m(r, c));
+}
+
 }  // namespace
+
+CoarseLayout CoarseLayout::For(int num_rods) {
+  if (num_rods <= kTurnsUpToRods) return {.chunks_per_rod = 4, .turns = true, .points_per_chunk = 4};
+  return {};
+}
 
 bool CoarseLevel::Build(const std::vector<CoarseRod>& rods, const std::vector<MatX>& blocks,
                         double scale) {
+  return Build(rods, blocks, scale, CoarseLayout::For(static_cast<int>(rods.size())));
+}
+
+bool CoarseLevel::Build(const std::vector<CoarseRod>& rods, const std::vector<MatX>& blocks,
+                        double scale, const CoarseLayout& layout) {
   SR_ASSERT(blocks.size() == rods.size(), "one block per rod");
+  SR_ASSERT(layout.chunks_per_rod >= 1 && layout.points_per_chunk >= 1, "a chunk and a point per chunk");
+  layout_ = layout;
+  modes_ = layout.modes();
   scale_ = scale;
   chunk_first_.clear();
   chunk_rod_.clear();
   rod_first_chunk_.clear();
   rod_first_node_.clear();
+  point_first_.clear();
+  point_chunk_.clear();
+  chunk_first_point_.clear();
   for (std::size_t r = 0; r < rods.size(); ++r) {
     const int n = static_cast<int>(rods[r].x->cols()), first = rods[r].node_offset;
-    const int chunks = std::min(kChunksPerRod, n);
+    const int chunks = std::min(layout.chunks_per_rod, n);
     rod_first_chunk_.push_back(static_cast<int>(chunk_first_.size()));
     rod_first_node_.push_back(first);
     for (int a = 0; a < chunks; ++a) {
-      chunk_first_.push_back(first + a * n / chunks);
+      const int begin = first + a * n / chunks, end = first + (a + 1) * n / chunks;
+      const int points = std::min(layout.points_per_chunk, end - begin);
+      chunk_first_point_.push_back(static_cast<int>(point_first_.size()));
+      for (int q = 0; q < points; ++q) {
+        point_first_.push_back(begin + q * (end - begin) / points);
+        point_chunk_.push_back(static_cast<int>(chunk_first_.size()));
+      }
+      chunk_first_.push_back(begin);
       chunk_rod_.push_back(static_cast<int>(r));
     }
   }
   const int nc = static_cast<int>(chunk_first_.size());
+  const int np = static_cast<int>(point_first_.size());
   const int m = rods.empty() ? 0 : rods.back().node_offset + static_cast<int>(rods.back().x->cols());
   chunk_first_.push_back(m);
+  chunk_first_point_.push_back(np);
+  point_first_.push_back(m);
   rod_first_chunk_.push_back(nc);
   rod_first_node_.push_back(m);
+  return layout.turns ? BuildWith<6>(rods, blocks) : BuildWith<3>(rods, blocks);
+}
 
-  // Nodes (3 × M, and by rows for the vectorized sums), chunk centroids and sizes.
+template <int K>
+bool CoarseLevel::BuildWith(const std::vector<CoarseRod>& rods, const std::vector<MatX>& blocks) {
+  using Block = Eigen::Matrix<double, 3, K>;
+  const double scale = scale_;
+  const int nc = num_chunks(), np = static_cast<int>(point_first_.size()) - 1, m = chunk_first_.back();
+  // Nodes (3 × M, and by rows for the vectorized sums), centroids of chunks and of points.
   NodeRows x(3, m);
   for (const CoarseRod& rod : rods) x.middleCols(rod.node_offset, rod.x->cols()) = *rod.x;
-  Matrix3X centroids(3, nc);
-  VecX chunk_eps(nc);
-  chunk_nodes_.resize(nc);
+  centroids_.resize(3, nc);
+  offsets_.resize(3, m);
   for (int b = 0; b < nc; ++b) {
     const int begin = chunk_first_[static_cast<size_t>(b)], end = chunk_first_[static_cast<size_t>(b) + 1];
-    chunk_nodes_(b) = end - begin;
-    centroids.col(b) = x.middleCols(begin, end - begin).rowwise().mean();
-    chunk_eps(b) = rods[static_cast<size_t>(chunk_rod_[static_cast<size_t>(b)])].eps;
+    centroids_.col(b) = x.middleCols(begin, end - begin).rowwise().mean();
+    for (int i = begin; i < end; ++i) offsets_.col(i) = x.col(i) - centroids_.col(b);
+  }
+  points_.resize(3, np);
+  point_nodes_.resize(np);
+  point_eps_.resize(np);
+  std::vector<Block> point_modes(static_cast<size_t>(np));  // scale N_s Z(Y_s − X_b)
+  for (int s = 0; s < np; ++s) {
+    const int begin = point_first_[static_cast<size_t>(s)], end = point_first_[static_cast<size_t>(s) + 1];
+    const int b = point_chunk_[static_cast<size_t>(s)];
+    point_nodes_(s) = end - begin;
+    points_.col(s) = x.middleCols(begin, end - begin).rowwise().mean();
+    point_eps_(s) = rods[static_cast<size_t>(chunk_rod_[static_cast<size_t>(b)])].eps;
+    point_modes[static_cast<size_t>(s)] = (scale * point_nodes_(s)) * ModesAt<K>(points_.col(s) - centroids_.col(b));
   }
 
-  // Within a rod: D_k Z_k, the block's columns summed over each chunk.
+  // Within a rod: D_k Z_k, the block's columns combined over each chunk's nodes.
   std::vector<MatX> own(rods.size());  // in double until E is formed; own_ keeps it in single
   for (std::size_t r = 0; r < rods.size(); ++r) {
     const int first = rods[r].node_offset, n = static_cast<int>(rods[r].x->cols());
     const int c0 = rod_first_chunk_[r], chunks = rod_first_chunk_[r + 1] - c0;
-    own[r].setZero(3 * n, 3 * chunks);
+    own[r].setZero(3 * n, K * chunks);
     for (int a = 0; a < chunks; ++a)
-      for (int j = chunk_first_[static_cast<size_t>(c0 + a)]; j < chunk_first_[static_cast<size_t>(c0 + a) + 1]; ++j)
-        own[r].middleCols<3>(3 * a) += blocks[r].middleCols<3>(3 * (j - first));
+      for (int j = chunk_first_[static_cast<size_t>(c0 + a)]; j < chunk_first_[static_cast<size_t>(c0 + a) + 1]; ++j) {
+        own[r].middleCols<3>(K * a) += blocks[r].middleCols<3>(3 * (j - first));
+        if constexpr (K == 6)
+          own[r].middleCols<3>(K * a + 3) -= blocks[r].middleCols<3>(3 * (j - first)).lazyProduct(Cross(offsets_.col(j)));
+      }
   }
 
-  // Between rods: the centroids' Stokeslets at the nodes (single precision, a preconditioner),
-  // corrected to the nodes' own Stokeslets where a node is near the chunk.
+  // Between rods: the points' Stokeslets at the nodes (single precision, a preconditioner),
+  // corrected to the nodes' own Stokeslets where a node is near the point.
   // Built with the preconditioner (kept up to 40 steps of ~4 GMRES products), applied once per
   // product: 40 Applies per Build is what a preconditioner rebuilt every 10 steps would see.
   between_ = MakeFastStokesletSum({.tolerance = 1e-3, .applies_per_build = 40.0});
-  between_->Build(centroids, chunk_eps, Matrix3X(x));
-  FindNearChunks(x, centroids, chunk_eps);
+  between_->Build(points_, point_eps_, Matrix3X(x));
+  FindNearPoints<K>(x);
 
-  // E = Zᵀ W: W's rows summed over each chunk a, each block in double and kept in single
-  // precision (what its LU takes; a double E of a hundred helices is 46 MB fresh at every
-  // rebuild). Row by row: within a rod the exact own blocks; between rods chunk a's nodes against
-  // every centroid at once (SumChunkAtPoints; one call per pair of chunks, as before 2026-11-28,
-  // took 92–121 ms of a rebuild on a hundred helices, 2400 × 2400, one thread, against 40–58 ms,
-  // and 23–37 against 10–16 ms on fifty, alternated in one sitting).
-  Eigen::MatrixXf e(3 * nc, 3 * nc);  // every block is written below
-  const Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor> centre_rows = centroids;
-  const VecX chunk_e2 = chunk_eps.cwiseProduct(chunk_eps);
+  // E = Zᵀ W: W's rows combined over each chunk a (Zᵀ = [I] or [I; [x_i − X_a]×] per node), each
+  // block in double and kept in single precision (what its LU takes; a double E of a hundred
+  // helices is 46 MB fresh at every rebuild). Row by row: within a rod the exact own blocks;
+  // between rods chunk a's nodes against every point at once (SumChunkAtPoints; one call per
+  // pair of chunks, as before 2026-11-28, took 92–121 ms of a rebuild on a hundred helices,
+  // 2400 × 2400, one thread, against 40–58 ms, and 23–37 against 10–16 ms on fifty, alternated
+  // in one sitting). With turns, Σ_i [d_i]× S_i = Σ_k [e_k]× (Σ_i d_ik S_i) from the moments.
+  Eigen::MatrixXf e(K * nc, K * nc);  // every block is written below
+  const NodeRows point_rows = points_;
+  const VecX point_e2 = point_eps_.cwiseProduct(point_eps_);
 #pragma omp parallel
   {
-    MatX sums(nc, 7);  // per centroid b, the seven sums over a's nodes
+    MatX sums(np, K == 6 ? 28 : 7);  // per point s, the sums over a's nodes (and moments)
 #pragma omp for schedule(dynamic, 4)
     for (int a = 0; a < nc; ++a) {
       const int rod_a = chunk_rod_[static_cast<size_t>(a)];
@@ -132,43 +250,60 @@ bool CoarseLevel::Build(const std::vector<CoarseRod>& rods, const std::vector<Ma
       const int own_first = rod_first_chunk_[static_cast<size_t>(rod_a)];
       const int own_end = rod_first_chunk_[static_cast<size_t>(rod_a) + 1];
       SumChunkAtPoints(x.row(0).data() + begin, x.row(1).data() + begin, x.row(2).data() + begin,
-                       end - begin, centre_rows.row(0).data(), centre_rows.row(1).data(),
-                       centre_rows.row(2).data(), chunk_e2.data(), nc, sums.data());
+                       end - begin, point_rows.row(0).data(), point_rows.row(1).data(),
+                       point_rows.row(2).data(), point_e2.data(), np,
+                       K == 6 ? centroids_.col(a).data() : nullptr, sums.data());
       for (int b = 0; b < nc; ++b) {
-        Mat3 block = Mat3::Zero();
+        Eigen::Matrix<double, K, K> block = Eigen::Matrix<double, K, K>::Zero();
         if (b >= own_first && b < own_end) {
           for (int i = begin; i < end; ++i)
-            block += own[static_cast<size_t>(rod_a)].block<3, 3>(3 * (i - first), 3 * (b - own_first));
+            block += ModesTransposedTimes<K>(
+                offsets_.col(i), own[static_cast<size_t>(rod_a)].block<3, K>(3 * (i - first), K * (b - own_first)));
         } else {
-          const double t[7] = {sums(b, 0), sums(b, 1), sums(b, 2), sums(b, 3),
-                               sums(b, 4), sums(b, 5), sums(b, 6)};
-          block = (scale * chunk_nodes_(b)) * StokesletMatrix(t);
+          for (int s = chunk_first_point_[static_cast<size_t>(b)]; s < chunk_first_point_[static_cast<size_t>(b) + 1]; ++s) {
+            double t[7];
+            for (int k = 0; k < 7; ++k) t[k] = sums(s, k);
+            Eigen::Matrix<double, K, 3> zs;
+            zs.template topRows<3>() = StokesletMatrix(t);
+            if constexpr (K == 6) {
+              zs.template bottomRows<3>().setZero();
+              for (int d = 0; d < 3; ++d) {
+                for (int k = 0; k < 7; ++k) t[k] = sums(s, 7 + 7 * d + k);
+                zs.template bottomRows<3>() += Cross(Vec3::Unit(d)) * StokesletMatrix(t);
+              }
+            }
+            block += zs * point_modes[static_cast<size_t>(s)];
+          }
         }
-        PutBlock(block, a, b, &e);
+        PutBlock<K>(block, a, b, &e);
       }
     }
   }
-  for (int i = 0, a = 0; i < m; ++i) {  // W's corrections near chunks (added in single precision)
+  for (int i = 0, a = 0; i < m; ++i) {  // W's corrections near points (added in single precision)
     while (i >= chunk_first_[static_cast<size_t>(a) + 1]) ++a;
-    for (int k = near_start_[static_cast<size_t>(i)]; k < near_start_[static_cast<size_t>(i) + 1]; ++k)
-      e.block<3, 3>(3 * a, 3 * near_chunk_[static_cast<size_t>(k)]) += near_block_[static_cast<size_t>(k)].cast<float>();
+    for (int k = near_start_[static_cast<size_t>(i)]; k < near_start_[static_cast<size_t>(i) + 1]; ++k) {
+      const int b = point_chunk_[static_cast<size_t>(near_point_[static_cast<size_t>(k)])];
+      const Eigen::Map<const Block> near(near_block_.data() + 3 * K * static_cast<std::ptrdiff_t>(k));
+      e.block<K, K>(K * a, K * b) += ModesTransposedTimes<K>(offsets_.col(i), near).template cast<float>();
+    }
   }
   const bool regular = lu_.Compute(std::move(e), LuStorage::kHalf);
 
-  // between_ sums every chunk, the own rod's too: take the own centroids' Stokeslets out of own
+  // between_ sums every point, the own rod's too: take the own points' Stokeslets out of own
   // (after E, which has the exact own blocks), so that W c = own c_k + between_.
   for (std::size_t r = 0; r < rods.size(); ++r) {
     const int first = rods[r].node_offset, n = static_cast<int>(rods[r].x->cols());
-    const int c0 = rod_first_chunk_[r], chunks = rod_first_chunk_[r + 1] - c0;
-    for (int i = 0; i < n; ++i)
-      for (int a = 0; a < chunks; ++a) {
-        const int b = c0 + a;
+    const int c0 = rod_first_chunk_[r];
+    for (int s = chunk_first_point_[static_cast<size_t>(c0)]; s < chunk_first_point_[static_cast<size_t>(rod_first_chunk_[r + 1])]; ++s) {
+      const int b = point_chunk_[static_cast<size_t>(s)];
+      for (int i = 0; i < n; ++i) {
         double t[7];
         SumPointStokeslets(x.row(0).data() + first + i, x.row(1).data() + first + i,
-                           x.row(2).data() + first + i, chunk_eps(b) * chunk_eps(b), 1,
-                           centroids.col(b).data(), t);
-        own[r].block<3, 3>(3 * i, 3 * a) -= (scale * chunk_nodes_(b)) * StokesletMatrix(t);
+                           x.row(2).data() + first + i, point_eps_(s) * point_eps_(s), 1,
+                           points_.col(s).data(), t);
+        own[r].block<3, K>(3 * i, K * (b - c0)) -= StokesletMatrix(t) * point_modes[static_cast<size_t>(s)];
       }
+    }
   }
   // Applied in single precision with double sums (GemvRowsMixed): half the bytes per product.
   own_.assign(rods.size(), Eigen::MatrixXf());
@@ -176,56 +311,81 @@ bool CoarseLevel::Build(const std::vector<CoarseRod>& rods, const std::vector<Ma
   return regular;
 }
 
-void CoarseLevel::FindNearChunks(const NodeRows& x, const Matrix3X& centroids,
-                                 const VecX& chunk_eps) {
-  const int nc = num_chunks(), m = chunk_first_.back();
-  VecX reach2(nc);  // (kNearReach × the chunk's radius about its centroid)²
-  for (int b = 0; b < nc; ++b) {
+template <int K>
+void CoarseLevel::FindNearPoints(const NodeRows& x) {
+  using Block = Eigen::Matrix<double, 3, K>;
+  const int np = static_cast<int>(point_first_.size()) - 1, m = chunk_first_.back();
+  VecX reach2(np);  // (kNearReach × the point's radius about its centroid)²
+  for (int s = 0; s < np; ++s) {
     double radius2 = 0.0;
-    for (int j = chunk_first_[static_cast<size_t>(b)]; j < chunk_first_[static_cast<size_t>(b) + 1]; ++j)
-      radius2 = std::max(radius2, (Vec3(x.col(j)) - centroids.col(b)).squaredNorm());
-    reach2(b) = kNearReach * kNearReach * radius2;
+    for (int j = point_first_[static_cast<size_t>(s)]; j < point_first_[static_cast<size_t>(s) + 1]; ++j)
+      radius2 = std::max(radius2, (Vec3(x.col(j)) - points_.col(s)).squaredNorm());
+    reach2(s) = kNearReach * kNearReach * radius2;
   }
   near_start_.assign(1, 0);
-  near_chunk_.clear();
+  near_point_.clear();
   near_block_.clear();
   int rod = 0;
   for (int i = 0; i < m; ++i) {
     while (i >= rod_first_node_[static_cast<size_t>(rod) + 1]) ++rod;
     const Vec3 p = x.col(i);
-    for (int b = 0; b < nc; ++b) {
-      if (chunk_rod_[static_cast<size_t>(b)] == rod || (p - centroids.col(b)).squaredNorm() >= reach2(b))
+    for (int s = 0; s < np; ++s) {
+      const int b = point_chunk_[static_cast<size_t>(s)];
+      if (chunk_rod_[static_cast<size_t>(b)] == rod || (p - points_.col(s)).squaredNorm() >= reach2(s))
         continue;
-      const int begin = chunk_first_[static_cast<size_t>(b)], end = chunk_first_[static_cast<size_t>(b) + 1];
-      const double e2 = chunk_eps(b) * chunk_eps(b);
-      double nodes[7], centroid[7];
-      SumPointStokeslets(x.row(0).data() + begin, x.row(1).data() + begin, x.row(2).data() + begin,
-                         e2, end - begin, p.data(), nodes);
-      const double* xb = centroids.col(b).data();
-      SumPointStokeslets(xb, xb + 1, xb + 2, e2, 1, p.data(), centroid);
-      near_chunk_.push_back(b);
-      near_block_.push_back(scale_ * (StokesletMatrix(nodes) - chunk_nodes_(b) * StokesletMatrix(centroid)));
+      // scale (Σ_j S(x_i − x_j) Z(x_j − X_b) − N_s S(x_i − Y_s) Z(Y_s − X_b)) over the point's
+      // nodes j (with forces alone Z = I: the nodes' Stokeslets summed at once).
+      const int begin = point_first_[static_cast<size_t>(s)], end = point_first_[static_cast<size_t>(s) + 1];
+      const double e2 = point_eps_(s) * point_eps_(s);
+      Block block;
+      double t[7];
+      if constexpr (K == 6) {
+        block.setZero();
+        for (int j = begin; j < end; ++j) {
+          SumPointStokeslets(x.row(0).data() + j, x.row(1).data() + j, x.row(2).data() + j, e2, 1,
+                             p.data(), t);
+          block += StokesletMatrix(t) * ModesAt<K>(offsets_.col(j));
+        }
+      } else {
+        SumPointStokeslets(x.row(0).data() + begin, x.row(1).data() + begin, x.row(2).data() + begin,
+                           e2, end - begin, p.data(), t);
+        block = StokesletMatrix(t);
+      }
+      const double* ys = points_.col(s).data();
+      SumPointStokeslets(ys, ys + 1, ys + 2, e2, 1, p.data(), t);
+      block -= point_nodes_(s) * StokesletMatrix(t) * ModesAt<K>(points_.col(s) - centroids_.col(b));
+      block *= scale_;
+      near_point_.push_back(s);
+      near_block_.insert(near_block_.end(), block.data(), block.data() + block.size());
     }
-    near_start_.push_back(static_cast<int>(near_chunk_.size()));
+    near_start_.push_back(static_cast<int>(near_point_.size()));
   }
 }
 
 VecX CoarseLevel::Solve(const VecX& v) const {
   const int nc = num_chunks();
-  VecX zv = VecX::Zero(3 * nc);
+  VecX zv = VecX::Zero(modes_ * nc);
   for (int a = 0; a < nc; ++a)
-    for (int i = chunk_first_[static_cast<size_t>(a)]; i < chunk_first_[static_cast<size_t>(a) + 1]; ++i)
-      zv.segment<3>(3 * a) += v.segment<3>(3 * i);
+    for (int i = chunk_first_[static_cast<size_t>(a)]; i < chunk_first_[static_cast<size_t>(a) + 1]; ++i) {
+      const Vec3 vi = v.segment<3>(3 * i);
+      zv.segment<3>(modes_ * a) += vi;
+      if (layout_.turns) zv.segment<3>(modes_ * a + 3) += Vec3(offsets_.col(i)).cross(vi);
+    }
   Eigen::VectorXf c = zv.cast<float>();
   lu_.Solve(&c);
   return c.cast<double>();
 }
 
 void CoarseLevel::ApplyW(const VecX& c, VecX* out) const {
-  const int nc = num_chunks(), m = chunk_first_.back();
-  strengths_.resize(3, nc);
-  for (int b = 0; b < nc; ++b) strengths_.col(b) = (scale_ * chunk_nodes_(b)) * c.segment<3>(3 * b);
-  between_->Apply(strengths_, &velocity_);  // every chunk, its own rod's too
+  const int np = static_cast<int>(point_first_.size()) - 1, m = chunk_first_.back();
+  strengths_.resize(3, np);
+  for (int s = 0; s < np; ++s) {
+    const int b = point_chunk_[static_cast<size_t>(s)];
+    Vec3 force = c.segment<3>(modes_ * b);
+    if (layout_.turns) force += c.segment<3>(modes_ * b + 3).cross(points_.col(s) - centroids_.col(b));
+    strengths_.col(s) = (scale_ * point_nodes_(s)) * force;
+  }
+  between_->Apply(strengths_, &velocity_);  // every point, its own rod's too
   out->resize(3 * m);
   const int num_rods = static_cast<int>(own_.size());
 #pragma omp parallel for schedule(static) if (num_rods > 1)
@@ -235,12 +395,18 @@ void CoarseLevel::ApplyW(const VecX& c, VecX* out) const {
     const int c0 = rod_first_chunk_[static_cast<size_t>(r)];
     const int chunks = rod_first_chunk_[static_cast<size_t>(r) + 1] - c0;
     const Eigen::MatrixXf& own = own_[static_cast<size_t>(r)];
-    SR_ASSERT(own.cols() == 3 * chunks, "the coarse level's own block does not match its chunks");
-    GemvRowsMixed(own, 0, 3 * n, c.data() + 3 * c0, out->data() + 3 * first);
+    SR_ASSERT(own.cols() == modes_ * chunks, "the coarse level's own block does not match its chunks");
+    GemvRowsMixed(own, 0, 3 * n, c.data() + modes_ * c0, out->data() + 3 * first);
     for (int i = first; i < first + n; ++i) {
       Vec3 u = velocity_.col(i);
-      for (int k = near_start_[static_cast<size_t>(i)]; k < near_start_[static_cast<size_t>(i) + 1]; ++k)
-        u += near_block_[static_cast<size_t>(k)] * c.segment<3>(3 * near_chunk_[static_cast<size_t>(k)]);
+      for (int k = near_start_[static_cast<size_t>(i)]; k < near_start_[static_cast<size_t>(i) + 1]; ++k) {
+        const int b = point_chunk_[static_cast<size_t>(near_point_[static_cast<size_t>(k)])];
+        const double* block = near_block_.data() + 3 * modes_ * static_cast<std::ptrdiff_t>(k);
+        if (layout_.turns)
+          u += Eigen::Map<const Eigen::Matrix<double, 3, 6>>(block) * c.segment<6>(6 * b);
+        else
+          u += Eigen::Map<const Mat3>(block) * c.segment<3>(3 * b);
+      }
       out->segment<3>(3 * i) += u;
     }
   }
@@ -248,8 +414,11 @@ void CoarseLevel::ApplyW(const VecX& c, VecX* out) const {
 
 void CoarseLevel::AddZ(const VecX& c, VecX* out) const {
   for (int a = 0; a < num_chunks(); ++a)
-    for (int i = chunk_first_[static_cast<size_t>(a)]; i < chunk_first_[static_cast<size_t>(a) + 1]; ++i)
-      out->segment<3>(3 * i) += c.segment<3>(3 * a);
+    for (int i = chunk_first_[static_cast<size_t>(a)]; i < chunk_first_[static_cast<size_t>(a) + 1]; ++i) {
+      out->segment<3>(3 * i) += c.segment<3>(modes_ * a);
+      if (layout_.turns)
+        out->segment<3>(3 * i) += c.segment<3>(modes_ * a + 3).cross(Vec3(offsets_.col(i)));
+    }
 }
 
 }  // namespace stokesrods
