@@ -30,6 +30,8 @@ void dgbtrs_(const char* trans, const int* n, const int* kl, const int* ku, cons
              int* info, std::size_t trans_len);
 }
 
+extern "C" void sgetrf_(const int* m, const int* n, float* a, const int* lda, int* ipiv, int* info);
+
 namespace stokesrods {
 namespace {
 
@@ -223,6 +225,27 @@ BENCHMARK_CAPTURE(BM_FloatLuSolve, blocked, false, LuStorage::kNative)
     ->Arg(390)->Arg(2400)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_FloatLuSolve, half, false, LuStorage::kHalf)
     ->Arg(390)->Arg(2400)->Unit(benchmark::kMicrosecond);
+
+// The float LU's factorization at the coarse level's sizes (E: 1200 at fifty helices, 2400 at a
+// hundred): one getrf call against LuFactor (from kBlockedLuFrom getrf's blocked algorithm with
+// its updates over the OpenMP threads, solver/dense_lu.h); run with OMP_NUM_THREADS 1 and 2.
+void BM_FloatLuFactor(benchmark::State& st, bool getrf) {
+  const int n = static_cast<int>(st.range(0));
+  const Eigen::MatrixXf a = Eigen::MatrixXf::Random(n, n);
+  Eigen::MatrixXf f;
+  std::vector<int> pivots(static_cast<size_t>(n));
+  int info = 0;
+  for (auto _ : st) {
+    f = a;
+    if (getrf)
+      sgetrf_(&n, &n, f.data(), &n, pivots.data(), &info);
+    else
+      LuFactor(n, f.data(), pivots.data(), &info);
+    benchmark::DoNotOptimize(f.data());
+  }
+}
+BENCHMARK_CAPTURE(BM_FloatLuFactor, getrf, true)->Arg(1200)->Arg(2400)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_FloatLuFactor, blocked, false)->Arg(1200)->Arg(2400)->Unit(benchmark::kMillisecond);
 
 // The same with LAPACK (dgbtrf, then dgbtrs for one right-hand side), same storage.
 void BM_BandedLapack(benchmark::State& st, bool solve) {

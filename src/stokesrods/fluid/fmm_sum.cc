@@ -59,29 +59,48 @@ extern "C" void dgemm_(const char* transa, const char* transb, const int* m, con
                        const double* b, const int* ldb, const double* beta, double* c,
                        const int* ldc);
 
-/// c = alpha a b by the BLAS (OpenBLAS: its kernels for the CPU at hand, on one thread so that
-/// the result does not depend on the thread count (solver/blas.h); the build itself targets
-/// baseline x86-64, where Eigen's products are 5–10× slower), over fixed blocks of kGemmColumns
-/// columns spread over the OpenMP threads: each column is that of its block's product, whatever
-/// the number of threads. (One product on one thread, the fits and translations were the largest
-/// serial part of a two-thread step on a hundred helices: docs/performance.md, session 19.)
+/// c_p = alpha a_p b_p for each p by the BLAS (OpenBLAS: its kernels for the CPU at hand, on one
+/// thread so that the result does not depend on the thread count (solver/blas.h); the build
+/// itself targets baseline x86-64, where Eigen's products are 5–10× slower), over fixed blocks of
+/// kGemmColumns columns, those of all the products at once, spread over the OpenMP threads: each
+/// column is that of its block's product, whatever the number of threads. (One product on one
+/// thread, the fits and translations were the largest serial part of a two-thread step on a
+/// hundred helices: docs/performance.md, session 19; the M2M and L2L's eight products of a few
+/// blocks each, one after the other, left the second thread waiting: session 27.)
 constexpr Eigen::Index kGemmColumns = 64;
-void GemmByColumns(const MatX& a, const MatX& b, double alpha, MatX* c) {
+void GemmByColumns(const std::vector<const MatX*>& a, const std::vector<const MatX*>& b,
+                   double alpha, std::vector<MatX*>* c) {
   SR_ASSERT(BlasIsSingleThreaded(), "the BLAS must run on one thread");
-  SR_ASSERT(b.rows() == a.cols(), "GemmByColumns: sizes");
-  c->resize(a.rows(), b.cols());
-  const int m = static_cast<int>(a.rows()), k = static_cast<int>(a.cols());
-  if (m == 0 || b.cols() == 0) return;
-  const Eigen::Index blocks = (b.cols() + kGemmColumns - 1) / kGemmColumns;
-#pragma omp parallel for schedule(static) if (blocks > 1)
-  for (Eigen::Index block = 0; block < blocks; ++block) {
-    const Eigen::Index first = block * kGemmColumns;
-    const int n = static_cast<int>(std::min(kGemmColumns, b.cols() - first));
+  struct Block {
+    std::size_t product;
+    Eigen::Index first;
+  };
+  std::vector<Block> blocks;
+  for (std::size_t p = 0; p < a.size(); ++p) {
+    SR_ASSERT(b[p]->rows() == a[p]->cols(), "GemmByColumns: sizes");
+    (*c)[p]->resize(a[p]->rows(), b[p]->cols());
+    if (a[p]->rows() == 0) continue;
+    for (Eigen::Index first = 0; first < b[p]->cols(); first += kGemmColumns) blocks.push_back({p, first});
+  }
+  const int num_blocks = static_cast<int>(blocks.size());
+#pragma omp parallel for schedule(dynamic) if (num_blocks > 1)
+  for (int i = 0; i < num_blocks; ++i) {
+    const MatX& ap = *a[blocks[static_cast<size_t>(i)].product];
+    const MatX& bp = *b[blocks[static_cast<size_t>(i)].product];
+    MatX& cp = *(*c)[blocks[static_cast<size_t>(i)].product];
+    const Eigen::Index first = blocks[static_cast<size_t>(i)].first;
+    const int m = static_cast<int>(ap.rows()), k = static_cast<int>(ap.cols());
+    const int n = static_cast<int>(std::min(kGemmColumns, bp.cols() - first));
     const char no = 'N';
     const double zero = 0.0;
-    dgemm_(&no, &no, &m, &n, &k, &alpha, a.data(), &m, b.data() + first * k, &k, &zero,
-           c->data() + first * m, &m);
+    dgemm_(&no, &no, &m, &n, &k, &alpha, ap.data(), &m, bp.data() + first * k, &k, &zero,
+           cp.data() + first * m, &m);
   }
+}
+
+void GemmByColumns(const MatX& a, const MatX& b, double alpha, MatX* c) {
+  std::vector<MatX*> out = {c};
+  GemmByColumns({&a}, {&b}, alpha, &out);
 }
 
 /// The translations between levels (M2M, L2L) of many boxes: out_j = ops[octant_j] in.col(column_j)
@@ -99,7 +118,12 @@ void TranslateByOctant(const std::array<MatX, 8>& ops, const MatX& in,
   for (std::size_t o = 0; o < 8; ++o) gathered[o].resize(in.rows(), count[o]);
   for (std::size_t j = 0; j < column.size(); ++j)
     gathered[static_cast<size_t>(octant[j])].col((*slot)[j]) = in.col(column[j]);
-  for (std::size_t o = 0; o < 8; ++o) GemmByColumns(ops[o], gathered[o], 1.0, &(*products)[o]);
+  // The eight products' column blocks over the threads at once (one octant holds a few blocks at
+  // most: alone, each product ran on one thread).
+  std::vector<const MatX*> a, b;
+  std::vector<MatX*> c;
+  for (std::size_t o = 0; o < 8; ++o) a.push_back(&ops[o]), b.push_back(&gathered[o]), c.push_back(&(*products)[o]);
+  GemmByColumns(a, b, 1.0, &c);
 }
 
 class FmmStokesletSum final : public StokesletSum {

@@ -322,12 +322,14 @@ void CoarseLevel::FindNearPoints(const NodeRows& x) {
       radius2 = std::max(radius2, (Vec3(x.col(j)) - points_.col(s)).squaredNorm());
     reach2(s) = kNearReach * kNearReach * radius2;
   }
-  near_start_.assign(1, 0);
-  near_point_.clear();
-  near_block_.clear();
-  int rod = 0;
+  // Node by node over the threads (each node's entries in point order), then joined in node
+  // order: the same lists on any number of threads.
+  std::vector<std::vector<int>> node_points(static_cast<size_t>(m));
+  std::vector<std::vector<double>> node_blocks(static_cast<size_t>(m));
+#pragma omp parallel for schedule(dynamic, 64)
   for (int i = 0; i < m; ++i) {
-    while (i >= rod_first_node_[static_cast<size_t>(rod) + 1]) ++rod;
+    const int rod = static_cast<int>(std::upper_bound(rod_first_node_.begin(), rod_first_node_.end(), i) -
+                                     rod_first_node_.begin()) - 1;
     const Vec3 p = x.col(i);
     for (int s = 0; s < np; ++s) {
       const int b = point_chunk_[static_cast<size_t>(s)];
@@ -355,9 +357,19 @@ void CoarseLevel::FindNearPoints(const NodeRows& x) {
       SumPointStokeslets(ys, ys + 1, ys + 2, e2, 1, p.data(), t);
       block -= point_nodes_(s) * StokesletMatrix(t) * ModesAt<K>(points_.col(s) - centroids_.col(b));
       block *= scale_;
-      near_point_.push_back(s);
-      near_block_.insert(near_block_.end(), block.data(), block.data() + block.size());
+      node_points[static_cast<size_t>(i)].push_back(s);
+      node_blocks[static_cast<size_t>(i)].insert(node_blocks[static_cast<size_t>(i)].end(), block.data(),
+                                                 block.data() + block.size());
     }
+  }
+  near_start_.assign(1, 0);
+  near_point_.clear();
+  near_block_.clear();
+  for (int i = 0; i < m; ++i) {
+    near_point_.insert(near_point_.end(), node_points[static_cast<size_t>(i)].begin(),
+                       node_points[static_cast<size_t>(i)].end());
+    near_block_.insert(near_block_.end(), node_blocks[static_cast<size_t>(i)].begin(),
+                       node_blocks[static_cast<size_t>(i)].end());
     near_start_.push_back(static_cast<int>(near_point_.size()));
   }
 }

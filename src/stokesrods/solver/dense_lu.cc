@@ -1,5 +1,6 @@
 #include "stokesrods/solver/dense_lu.h"
 
+#include <algorithm>
 #include <type_traits>
 #include <utility>
 
@@ -9,6 +10,22 @@
 extern "C" {
 void sgetrf_(const int* m, const int* n, float* a, const int* lda, int* ipiv, int* info);
 void dgetrf_(const int* m, const int* n, double* a, const int* lda, int* ipiv, int* info);
+void slaswp_(const int* n, float* a, const int* lda, const int* k1, const int* k2, const int* ipiv,
+             const int* incx);
+void dlaswp_(const int* n, double* a, const int* lda, const int* k1, const int* k2,
+             const int* ipiv, const int* incx);
+void strsm_(const char* side, const char* uplo, const char* transa, const char* diag, const int* m,
+            const int* n, const float* alpha, const float* a, const int* lda, float* b,
+            const int* ldb, std::size_t, std::size_t, std::size_t, std::size_t);
+void dtrsm_(const char* side, const char* uplo, const char* transa, const char* diag, const int* m,
+            const int* n, const double* alpha, const double* a, const int* lda, double* b,
+            const int* ldb, std::size_t, std::size_t, std::size_t, std::size_t);
+void sgemm_(const char* transa, const char* transb, const int* m, const int* n, const int* k,
+            const float* alpha, const float* a, const int* lda, const float* b, const int* ldb,
+            const float* beta, float* c, const int* ldc, std::size_t, std::size_t);
+void dgemm_(const char* transa, const char* transb, const int* m, const int* n, const int* k,
+            const double* alpha, const double* a, const int* lda, const double* b, const int* ldb,
+            const double* beta, double* c, const int* ldc, std::size_t, std::size_t);
 void sgetrs_(const char* trans, const int* n, const int* nrhs, const float* a, const int* lda,
              const int* ipiv, float* b, const int* ldb, int* info, std::size_t trans_len);
 void dgetrs_(const char* trans, const int* n, const int* nrhs, const double* a, const int* lda,
@@ -18,8 +35,80 @@ void dgetrs_(const char* trans, const int* n, const int* nrhs, const double* a, 
 namespace stokesrods {
 namespace {
 
-void Getrf(int n, float* a, int* ipiv, int* info) { sgetrf_(&n, &n, a, &n, ipiv, info); }
-void Getrf(int n, double* a, int* ipiv, int* info) { dgetrf_(&n, &n, a, &n, ipiv, info); }
+// The LAPACK and BLAS calls of one column-major matrix with leading dimension ld.
+void Getrf(int m, int n, float* a, int ld, int* ipiv, int* info) { sgetrf_(&m, &n, a, &ld, ipiv, info); }
+void Getrf(int m, int n, double* a, int ld, int* ipiv, int* info) { dgetrf_(&m, &n, a, &ld, ipiv, info); }
+template <typename Scalar>
+void Laswp(int n, Scalar* a, int ld, int k1, int k2, const int* ipiv) {
+  const int one = 1;
+  if constexpr (std::is_same_v<Scalar, float>)
+    slaswp_(&n, a, &ld, &k1, &k2, ipiv, &one);
+  else
+    dlaswp_(&n, a, &ld, &k1, &k2, ipiv, &one);
+}
+// b = L⁻¹ b, L unit lower triangular (m × m), b m × n.
+template <typename Scalar>
+void TrsmUnitLower(int m, int n, const Scalar* l, int ld, Scalar* b) {
+  const Scalar one = 1;
+  if constexpr (std::is_same_v<Scalar, float>)
+    strsm_("L", "L", "N", "U", &m, &n, &one, l, &ld, b, &ld, 1, 1, 1, 1);
+  else
+    dtrsm_("L", "L", "N", "U", &m, &n, &one, l, &ld, b, &ld, 1, 1, 1, 1);
+}
+// c −= a b, a m × k, b k × n.
+template <typename Scalar>
+void GemmSubtract(int m, int n, int k, const Scalar* a, const Scalar* b, Scalar* c, int ld) {
+  const Scalar minus_one = -1, one = 1;
+  if constexpr (std::is_same_v<Scalar, float>)
+    sgemm_("N", "N", &m, &n, &k, &minus_one, a, &ld, b, &ld, &one, c, &ld, 1, 1);
+  else
+    dgemm_("N", "N", &m, &n, &k, &minus_one, a, &ld, b, &ld, &one, c, &ld, 1, 1);
+}
+
+// The LU with partial pivoting of a (n × n) by LAPACK's right-looking blocked algorithm (that of
+// getrf), each panel of kPanel columns by getrf itself and the rest of each step over fixed
+// blocks of kColumns columns spread over the OpenMP threads: a block's row interchanges,
+// triangular solve and product are each one single-threaded BLAS call whose shape does not
+// depend on the thread count, so the factors are the same bits on one thread or two (the BLAS
+// runs on one: solver/blas.h), where getrf alone would leave the second core idle (E of the
+// coarse level at a hundred helices, 2400 × 2400, 178 ms at every rebuild: docs/performance.md,
+// session 27). info as getrf's: the first exactly zero pivot (1-based), or 0.
+template <typename Scalar>
+void BlockedGetrf(int n, Scalar* a, int* ipiv, int* info) {
+  constexpr int kPanel = 128, kColumns = 128;
+  *info = 0;
+  for (int k = 0; k < n; k += kPanel) {
+    const int nb = std::min(kPanel, n - k), m = n - k;
+    int panel_info = 0;
+    Getrf(m, nb, a + k + static_cast<std::ptrdiff_t>(k) * n, n, ipiv + k, &panel_info);
+    if (panel_info > 0 && *info == 0) *info = panel_info + k;
+    for (int i = k; i < k + nb; ++i) ipiv[i] += k;  // rows of the whole matrix (1-based)
+    // The panel's interchanges on the columns left of it and right of it; right of it also
+    // U₁₂ = L₁₁⁻¹ A₁₂ and A₂₂ −= L₂₁ U₁₂, column block by column block.
+    const int left_blocks = (k + kColumns - 1) / kColumns;
+    const int right_first = k + nb, right_blocks = (n - right_first + kColumns - 1) / kColumns;
+    const int blocks = left_blocks + right_blocks;
+#pragma omp parallel for schedule(static) if (blocks > 1)
+    for (int b = 0; b < blocks; ++b) {
+      const bool right = b >= left_blocks;
+      const int j0 = right ? right_first + (b - left_blocks) * kColumns : b * kColumns;
+      const int w = std::min(kColumns, (right ? n : k) - j0);
+      Scalar* column = a + static_cast<std::ptrdiff_t>(j0) * n;
+      Laswp(w, column, n, k + 1, k + nb, ipiv);
+      if (!right) continue;
+      TrsmUnitLower(nb, w, a + k + static_cast<std::ptrdiff_t>(k) * n, n, column + k);
+      if (m > nb)
+        GemmSubtract(m - nb, w, nb, a + (k + nb) + static_cast<std::ptrdiff_t>(k) * n, column + k,
+                     column + k + nb, n);
+    }
+  }
+}
+
+template <typename Scalar>
+void Factor(int n, Scalar* a, int* ipiv, int* info) {
+  if (n >= kBlockedLuFrom) return BlockedGetrf(n, a, ipiv, info);
+  Getrf(n, n, a, n, ipiv, info);
+}
 void Getrs(int n, const float* a, const int* ipiv, float* b, int* info) {
   const int one = 1;
   sgetrs_("N", &n, &one, a, &n, ipiv, b, &n, info, 1);
@@ -30,6 +119,9 @@ void Getrs(int n, const double* a, const int* ipiv, double* b, int* info) {
 }
 
 }  // namespace
+
+void LuFactor(int n, float* a, int* ipiv, int* info) { Factor(n, a, ipiv, info); }
+void LuFactor(int n, double* a, int* ipiv, int* info) { Factor(n, a, ipiv, info); }
 
 template <typename Scalar>
 bool DenseLu<Scalar>::Compute(Matrix a, LuStorage storage) {
@@ -43,7 +135,7 @@ bool DenseLu<Scalar>::Compute(Matrix a, LuStorage storage) {
   pivots_.resize(static_cast<std::size_t>(n));
   if (n == 0) return true;
   int info = 0;
-  Getrf(n, lu_.data(), pivots_.data(), &info);
+  LuFactor(n, lu_.data(), pivots_.data(), &info);
   SR_ASSERT(info >= 0, "DenseLu: bad argument to getrf");
   if constexpr (std::is_same_v<Scalar, float>) {
     if (info == 0 && storage == LuStorage::kHalf && (HasLuSolveHalfAvx512() || HasLuSolveAvx2())) {

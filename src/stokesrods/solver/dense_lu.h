@@ -1,5 +1,6 @@
 // The LU factorization (partial pivoting) of a dense square matrix and its solves, by LAPACK
-// (getrf/getrs from OpenBLAS: blocked, vectorized for the CPU at hand). Eigen's PartialPivLU does
+// (getrf/getrs from OpenBLAS: blocked, vectorized for the CPU at hand; from n = kBlockedLuFrom
+// getrf's blocked algorithm with its updates over the OpenMP threads). Eigen's PartialPivLU does
 // the same arithmetic, but the build targets baseline x86-64, where its kernels use SSE2 only;
 // for the capacitance's preconditioner (3M up to 3000) this is 2–4× faster (bench_step).
 // Single precision for preconditioners (half the memory each solve streams), double otherwise.
@@ -21,6 +22,14 @@ enum class LuStorage {
   /// rounding of 2⁻¹¹ per entry).
   kHalf,
 };
+
+/// The factorization DenseLu::Compute takes, in place: getrf's factors and 1-based pivots (info as
+/// getrf's: the first exactly zero pivot, or 0). Below kBlockedLuFrom one getrf; from there
+/// LAPACK's blocked algorithm with each step's update over fixed column blocks spread over the
+/// OpenMP threads (the same bits on any number of threads; dense_lu.cc).
+inline constexpr int kBlockedLuFrom = 1024;
+void LuFactor(int n, float* a, int* ipiv, int* info);
+void LuFactor(int n, double* a, int* ipiv, int* info);
 
 template <typename Scalar>
 class DenseLu {
