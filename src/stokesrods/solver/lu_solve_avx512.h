@@ -12,7 +12,11 @@ namespace stokesrods {
 /// chunks of kLuChunkRows over the OpenMP threads (fixed chunks: the same result on any number).
 inline constexpr int kLuBlock = 32;
 inline constexpr int kLuWideBlock = 128;
-inline constexpr int kLuChunkRows = 1024;
+/// 256 since 2026-11-28 (was 1024: at n = 2400 the rows below a block past row 1376 were one
+/// chunk, on one thread; the half solve of E then took 762 µs on two threads against 590 on one,
+/// and 567–658 with 256: bench_step BM_FloatLuSolve/half/2400, memory bound on the host's two
+/// threads).
+inline constexpr int kLuChunkRows = 256;
 inline constexpr int kParallelLuSolve = 1024;
 
 /// x ← A⁻¹ x, A = P L U column-major with leading dimension n, `pivots` 1-based (LAPACK's).
