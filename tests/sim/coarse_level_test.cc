@@ -39,8 +39,12 @@ struct Lattice {
   std::vector<CoarseRod> rods;
 };
 
-Lattice MakeLattice() {
-  const Matrix3X all = testing::HelixLattice(2, 3).targets;
+// straight: the helices' axes instead (nodes on lines: a chunk cannot turn about its line).
+Lattice MakeLattice(bool straight = false) {
+  Matrix3X all = testing::HelixLattice(2, 3).targets;
+  if (straight)
+    for (Eigen::Index i = 0; i < all.cols(); ++i)
+      all.col(i).head<2>() = Vec3(0.04 * static_cast<double>(i / kNodes / 3), 0.04 * static_cast<double>(i / kNodes % 3), 0.0).head<2>();
   Lattice l;
   std::mt19937 rng(7);
   std::normal_distribution<double> normal;
@@ -65,6 +69,15 @@ Vec3 Centroid(const Lattice& l, int begin, int end) {
   return c / static_cast<double>(end - begin);
 }
 
+// The RMS distance of nodes [begin, end) from their centroid (1 for one node): a turn's unit.
+double Radius(const Lattice& l, int begin, int end) {
+  const Vec3 c = Centroid(l, begin, end);
+  double sum = 0.0;
+  for (int j = begin; j < end; ++j) sum += (Node(l, j) - c).squaredNorm();
+  const double radius = std::sqrt(sum / static_cast<double>(end - begin));
+  return radius > 0.0 ? radius : 1.0;
+}
+
 // The coarse space of one layout, written out as coarse_level.h defines it.
 struct Space {
   CoarseLayout layout;
@@ -73,7 +86,7 @@ struct Space {
   // The chunks of rod r as CoarseLevel makes them: [first + a n / K, first + (a + 1) n / K).
   int ChunkBegin(int r, int a) const { return r * kNodes + a * kNodes / chunks(); }
   int ChunkEnd(int r, int a) const { return a + 1 < chunks() ? ChunkBegin(r, a + 1) : (r + 1) * kNodes; }
-  // Z at d from the chunk's centroid: the nodal force F (+ Ω × d) of the modes.
+  // Z at d from the chunk's centroid in units of its radius: the nodal force F (+ Ω × d).
   MatX Modes(const Vec3& d) const {
     MatX z = MatX::Zero(3, modes());
     z.leftCols<3>() = Mat3::Identity();
@@ -95,6 +108,7 @@ MatX ReferenceW(const Lattice& l, const Space& z, bool node_to_node, int* near_b
     for (int a = 0; a < z.chunks(); ++a) {
       const int b = rb * z.chunks() + a, begin = z.ChunkBegin(rb, a), end = z.ChunkEnd(rb, a);
       const Vec3 centroid = Centroid(l, begin, end);
+      const double rho = Radius(l, begin, end);
       for (int i = 0; i < m; ++i) {
         const int ri = i / kNodes;
         const Vec3 p = Node(l, i);
@@ -102,10 +116,10 @@ MatX ReferenceW(const Lattice& l, const Space& z, bool node_to_node, int* near_b
         if (ri == rb) {
           for (int j = begin; j < end; ++j)
             block += l.blocks[static_cast<size_t>(ri)].block<3, 3>(3 * (i % kNodes), 3 * (j - rb * kNodes)) *
-                     z.Modes(Node(l, j) - centroid);
+                     z.Modes((Node(l, j) - centroid) / rho);
         } else if (node_to_node) {
           for (int j = begin; j < end; ++j)
-            block += kScale * Stokeslet(p - Node(l, j), kEps) * z.Modes(Node(l, j) - centroid);
+            block += kScale * Stokeslet(p - Node(l, j), kEps) * z.Modes((Node(l, j) - centroid) / rho);
         } else {
           for (int q = 0; q < points; ++q) {
             const int p0 = begin + q * (end - begin) / points, p1 = begin + (q + 1) * (end - begin) / points;
@@ -115,9 +129,9 @@ MatX ReferenceW(const Lattice& l, const Space& z, bool node_to_node, int* near_b
             if ((p - y).norm() < 2.0 * radius) {
               if (near_blocks) ++*near_blocks;
               for (int j = p0; j < p1; ++j)
-                block += kScale * Stokeslet(p - Node(l, j), kEps) * z.Modes(Node(l, j) - centroid);
+                block += kScale * Stokeslet(p - Node(l, j), kEps) * z.Modes((Node(l, j) - centroid) / rho);
             } else {
-              block += kScale * static_cast<double>(p1 - p0) * Stokeslet(p - y, kEps) * z.Modes(y - centroid);
+              block += kScale * static_cast<double>(p1 - p0) * Stokeslet(p - y, kEps) * z.Modes((y - centroid) / rho);
             }
           }
         }
@@ -134,9 +148,10 @@ MatX ZTranspose(const Lattice& l, const Space& z, const MatX& w) {
   for (int r = 0; r < rods; ++r)
     for (int a = 0; a < z.chunks(); ++a) {
       const Vec3 centroid = Centroid(l, z.ChunkBegin(r, a), z.ChunkEnd(r, a));
+      const double rho = Radius(l, z.ChunkBegin(r, a), z.ChunkEnd(r, a));
       for (int i = z.ChunkBegin(r, a); i < z.ChunkEnd(r, a); ++i)
         out.middleRows(modes * (r * z.chunks() + a), modes) +=
-            z.Modes(Node(l, i) - centroid).transpose() * w.middleRows<3>(3 * i);
+            z.Modes((Node(l, i) - centroid) / rho).transpose() * w.middleRows<3>(3 * i);
     }
   return out;
 }
@@ -164,38 +179,56 @@ TEST_P(CoarseLevelLayout, ProductMatchesTheAssembledW) {
   }
 }
 
+// E as the coarse level factorizes it: Zᵀ W, with turns plus a thousandth of each chunk's mean
+// force diagonal on its turn diagonal (what keeps E regular when a chunk lies on a line).
+MatX RegularizedE(const Space& z, MatX e) {
+  if (z.layout.turns)
+    for (Eigen::Index a = 0; a < e.rows() / 6; ++a) {
+      const double tau = 1e-3 * (e(6 * a, 6 * a) + e(6 * a + 1, 6 * a + 1) + e(6 * a + 2, 6 * a + 2)) / 3.0;
+      for (int k = 3; k < 6; ++k) e(6 * a + k, 6 * a + k) += tau;
+    }
+  return e;
+}
+
+// On the helices and on straight rods (a chunk on a line: a turn of zero force, E regular only by
+// its regularization).
 TEST_P(CoarseLevelLayout, SolveInvertsZTransposeW) {
-  const Lattice l = MakeLattice();
-  const Space z{GetParam()};
-  CoarseLevel coarse;
-  ASSERT_TRUE(coarse.Build(l.rods, l.blocks, kScale, z.layout));
-  const MatX w = ReferenceW(l, z, false);
-  const MatX ztw = ZTranspose(l, z, w);
-  std::mt19937 rng(5);
-  std::normal_distribution<double> normal;
-  const VecX v = VecX::NullaryExpr(w.rows(), [&]() { return normal(rng); });
-  const VecX c = coarse.Solve(v);
-  const VecX ztv = ZTranspose(l, z, v);
-  // E's LU factors are kept in half precision (DenseLu kHalf, where the CPU allows it, else in
-  // single): rounding them perturbs E by at most u |L||U| entrywise, u = 2⁻¹¹ (4.9e-4), which
-  // partial pivoting keeps near u ‖E‖ (the factorization's own single-precision error is 500×
-  // smaller). Residual within 2 u ‖E‖₂ ‖c‖ (measured 0.13 u ‖E‖₂ ‖c‖ with forces alone, which
-  // E's conditioning makes 1.1 % of ‖Zᵀv‖); an E inconsistent with W would miss by O(‖Zᵀv‖).
-  MatX u_svd, v_svd;
-  VecX sigma;
-  ASSERT_TRUE(ThinSvd(ztw, &u_svd, &sigma, &v_svd));
-  const double norm_e = sigma(0);
-  const double residual = (ztw * c - ztv).norm();
-  std::printf("  coarse solve: residual %.2e of ‖E‖‖c‖, %.2e of ‖Zᵀv‖\n",
-              residual / (norm_e * c.norm()), residual / ztv.norm());
-  EXPECT_LT(residual, 2.0 * 4.9e-4 * norm_e * c.norm());
-  EXPECT_LT(residual, 0.05 * ztv.norm());
-  VecX y = VecX::Zero(v.size());
-  coarse.AddZ(c, &y);  // Z c: each node takes its chunk's force (and turn), F + Ω × (x_i − X_b)
-  const int node = kNodes + 1, chunk = z.chunks();  // rod 1's second node, in its first chunk
-  const Vec3 d = Node(l, node) - Centroid(l, z.ChunkBegin(1, 0), z.ChunkEnd(1, 0));
-  const VecX mine = c.segment(z.modes() * chunk, z.modes());
-  EXPECT_LT((y.segment<3>(3 * node) - z.Modes(d) * mine).norm(), 1e-12 * mine.norm());
+  for (const bool straight : {false, true}) {
+    const Lattice l = MakeLattice(straight);
+    const Space z{GetParam()};
+    CoarseLevel coarse;
+    ASSERT_TRUE(coarse.Build(l.rods, l.blocks, kScale, z.layout)) << straight;
+    const MatX w = ReferenceW(l, z, false);
+    const MatX e = RegularizedE(z, ZTranspose(l, z, w));
+    std::mt19937 rng(5);
+    std::normal_distribution<double> normal;
+    const VecX v = VecX::NullaryExpr(w.rows(), [&]() { return normal(rng); });
+    const VecX c = coarse.Solve(v);
+    ASSERT_TRUE(c.allFinite()) << straight;
+    const VecX ztv = ZTranspose(l, z, v);
+    // E's LU factors are kept in half precision (DenseLu kHalf, where the CPU allows it, else in
+    // single): rounding them perturbs E by at most u |L||U| entrywise, u = 2⁻¹¹ (4.9e-4), which
+    // partial pivoting keeps near u ‖E‖ (the factorization's own single-precision error is 500×
+    // smaller). Residual within 2 u ‖E‖₂ ‖c‖ (measured 0.13 u ‖E‖₂ ‖c‖ with forces alone, which
+    // E's conditioning makes 1.1 % of ‖Zᵀv‖); an E inconsistent with W would miss by O(‖Zᵀv‖).
+    MatX u_svd, v_svd;
+    VecX sigma;
+    ASSERT_TRUE(ThinSvd(e, &u_svd, &sigma, &v_svd));
+    const double norm_e = sigma(0);
+    const double residual = (e * c - ztv).norm();
+    std::printf("  %s: coarse solve residual %.2e of ‖E‖‖c‖, %.2e of ‖Zᵀv‖\n",
+                straight ? "straight rods" : "helices", residual / (norm_e * c.norm()),
+                residual / ztv.norm());
+    EXPECT_LT(residual, 2.0 * 4.9e-4 * norm_e * c.norm()) << straight;
+    EXPECT_LT(residual, 0.05 * ztv.norm()) << straight;
+    VecX y = VecX::Zero(v.size());
+    coarse.AddZ(c, &y);  // Z c: each node takes its chunk's force (and turn), F + Ω × (x_i − X_b) / ρ_b
+    const int node = kNodes + 1, chunk = z.chunks();  // rod 1's second node, in its first chunk
+    const Vec3 d = (Node(l, node) - Centroid(l, z.ChunkBegin(1, 0), z.ChunkEnd(1, 0))) /
+                   Radius(l, z.ChunkBegin(1, 0), z.ChunkEnd(1, 0));
+    const VecX mine = c.segment(z.modes() * chunk, z.modes());
+    EXPECT_LT((y.segment<3>(3 * node) - z.Modes(d) * mine).norm(), 1e-12 * mine.norm()) << straight;
+  }
 }
 
 TEST_P(CoarseLevelLayout, PointsApproximateTheNodeToNodeCoupling) {

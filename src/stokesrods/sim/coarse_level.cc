@@ -188,13 +188,18 @@ bool CoarseLevel::BuildWith(const std::vector<CoarseRod>& rods, const std::vecto
   NodeRows x(3, m);
   for (const CoarseRod& rod : rods) x.middleCols(rod.node_offset, rod.x->cols()) = *rod.x;
   centroids_.resize(3, nc);
-  offsets_.resize(3, m);
+  chunk_radius_.resize(nc);
+  arms_.resize(3, m);
   for (int b = 0; b < nc; ++b) {
     const int begin = chunk_first_[static_cast<size_t>(b)], end = chunk_first_[static_cast<size_t>(b) + 1];
     centroids_.col(b) = x.middleCols(begin, end - begin).rowwise().mean();
-    for (int i = begin; i < end; ++i) offsets_.col(i) = x.col(i) - centroids_.col(b);
+    const double radius = std::sqrt(
+        (x.middleCols(begin, end - begin).colwise() - centroids_.col(b)).squaredNorm() / (end - begin));
+    chunk_radius_(b) = radius > 0.0 ? radius : 1.0;  // one node: no turn at all, any length
+    for (int i = begin; i < end; ++i) arms_.col(i) = (x.col(i) - centroids_.col(b)) / chunk_radius_(b);
   }
   points_.resize(3, np);
+  point_arms_.resize(3, np);
   point_nodes_.resize(np);
   point_eps_.resize(np);
   std::vector<Block> point_modes(static_cast<size_t>(np));  // scale N_s Z(Y_s − X_b)
@@ -204,7 +209,8 @@ bool CoarseLevel::BuildWith(const std::vector<CoarseRod>& rods, const std::vecto
     point_nodes_(s) = end - begin;
     points_.col(s) = x.middleCols(begin, end - begin).rowwise().mean();
     point_eps_(s) = rods[static_cast<size_t>(chunk_rod_[static_cast<size_t>(b)])].eps;
-    point_modes[static_cast<size_t>(s)] = (scale * point_nodes_(s)) * ModesAt<K>(points_.col(s) - centroids_.col(b));
+    point_arms_.col(s) = (points_.col(s) - centroids_.col(b)) / chunk_radius_(b);
+    point_modes[static_cast<size_t>(s)] = (scale * point_nodes_(s)) * ModesAt<K>(point_arms_.col(s));
   }
 
   // Within a rod: D_k Z_k, the block's columns combined over each chunk's nodes.
@@ -217,7 +223,7 @@ bool CoarseLevel::BuildWith(const std::vector<CoarseRod>& rods, const std::vecto
       for (int j = chunk_first_[static_cast<size_t>(c0 + a)]; j < chunk_first_[static_cast<size_t>(c0 + a) + 1]; ++j) {
         own[r].middleCols<3>(K * a) += blocks[r].middleCols<3>(3 * (j - first));
         if constexpr (K == 6)
-          own[r].middleCols<3>(K * a + 3) -= blocks[r].middleCols<3>(3 * (j - first)).lazyProduct(Cross(offsets_.col(j)));
+          own[r].middleCols<3>(K * a + 3) -= blocks[r].middleCols<3>(3 * (j - first)).lazyProduct(Cross(arms_.col(j)));
       }
   }
 
@@ -258,7 +264,7 @@ bool CoarseLevel::BuildWith(const std::vector<CoarseRod>& rods, const std::vecto
         if (b >= own_first && b < own_end) {
           for (int i = begin; i < end; ++i)
             block += ModesTransposedTimes<K>(
-                offsets_.col(i), own[static_cast<size_t>(rod_a)].block<3, K>(3 * (i - first), K * (b - own_first)));
+                arms_.col(i), own[static_cast<size_t>(rod_a)].block<3, K>(3 * (i - first), K * (b - own_first)));
         } else {
           for (int s = chunk_first_point_[static_cast<size_t>(b)]; s < chunk_first_point_[static_cast<size_t>(b) + 1]; ++s) {
             double t[7];
@@ -271,6 +277,7 @@ bool CoarseLevel::BuildWith(const std::vector<CoarseRod>& rods, const std::vecto
                 for (int k = 0; k < 7; ++k) t[k] = sums(s, 7 + 7 * d + k);
                 zs.template bottomRows<3>() += Cross(Vec3::Unit(d)) * StokesletMatrix(t);
               }
+              zs.template bottomRows<3>() /= chunk_radius_(a);  // the moments of x_i − X_a
             }
             block += zs * point_modes[static_cast<size_t>(s)];
           }
@@ -284,7 +291,18 @@ bool CoarseLevel::BuildWith(const std::vector<CoarseRod>& rods, const std::vecto
     for (int k = near_start_[static_cast<size_t>(i)]; k < near_start_[static_cast<size_t>(i) + 1]; ++k) {
       const int b = point_chunk_[static_cast<size_t>(near_point_[static_cast<size_t>(k)])];
       const Eigen::Map<const Block> near(near_block_.data() + 3 * K * static_cast<std::ptrdiff_t>(k));
-      e.block<K, K>(K * a, K * b) += ModesTransposedTimes<K>(offsets_.col(i), near).template cast<float>();
+      e.block<K, K>(K * a, K * b) += ModesTransposedTimes<K>(arms_.col(i), near).template cast<float>();
+    }
+  }
+  if constexpr (K == 6) {
+    // A chunk whose nodes lie on a line (a straight rod) cannot turn about that line: Z's column
+    // is zero, and so are E's row and column. τ on each turn's diagonal, a thousandth of the
+    // chunk's force diagonal, keeps E regular; it leaves such a turn at zero (its right-hand side
+    // Zᵀ r is zero too) and the others changed by ~1e-3 (the turns are scaled by the chunk's
+    // radius, so both diagonals are of a size).
+    for (int a = 0; a < nc; ++a) {
+      const float tau = kTurnRegularization * (e(6 * a, 6 * a) + e(6 * a + 1, 6 * a + 1) + e(6 * a + 2, 6 * a + 2)) / 3.0f;
+      for (int k = 3; k < 6; ++k) e(6 * a + k, 6 * a + k) += tau;
     }
   }
   const bool regular = lu_.Compute(std::move(e), LuStorage::kHalf);
@@ -346,7 +364,7 @@ void CoarseLevel::FindNearPoints(const NodeRows& x) {
         for (int j = begin; j < end; ++j) {
           SumPointStokeslets(x.row(0).data() + j, x.row(1).data() + j, x.row(2).data() + j, e2, 1,
                              p.data(), t);
-          block += StokesletMatrix(t) * ModesAt<K>(offsets_.col(j));
+          block += StokesletMatrix(t) * ModesAt<K>(arms_.col(j));
         }
       } else {
         SumPointStokeslets(x.row(0).data() + begin, x.row(1).data() + begin, x.row(2).data() + begin,
@@ -355,7 +373,7 @@ void CoarseLevel::FindNearPoints(const NodeRows& x) {
       }
       const double* ys = points_.col(s).data();
       SumPointStokeslets(ys, ys + 1, ys + 2, e2, 1, p.data(), t);
-      block -= point_nodes_(s) * StokesletMatrix(t) * ModesAt<K>(points_.col(s) - centroids_.col(b));
+      block -= point_nodes_(s) * StokesletMatrix(t) * ModesAt<K>(point_arms_.col(s));
       block *= scale_;
       node_points[static_cast<size_t>(i)].push_back(s);
       node_blocks[static_cast<size_t>(i)].insert(node_blocks[static_cast<size_t>(i)].end(), block.data(),
@@ -381,7 +399,7 @@ VecX CoarseLevel::Solve(const VecX& v) const {
     for (int i = chunk_first_[static_cast<size_t>(a)]; i < chunk_first_[static_cast<size_t>(a) + 1]; ++i) {
       const Vec3 vi = v.segment<3>(3 * i);
       zv.segment<3>(modes_ * a) += vi;
-      if (layout_.turns) zv.segment<3>(modes_ * a + 3) += Vec3(offsets_.col(i)).cross(vi);
+      if (layout_.turns) zv.segment<3>(modes_ * a + 3) += Vec3(arms_.col(i)).cross(vi);
     }
   Eigen::VectorXf c = zv.cast<float>();
   lu_.Solve(&c);
@@ -394,7 +412,7 @@ void CoarseLevel::ApplyW(const VecX& c, VecX* out) const {
   for (int s = 0; s < np; ++s) {
     const int b = point_chunk_[static_cast<size_t>(s)];
     Vec3 force = c.segment<3>(modes_ * b);
-    if (layout_.turns) force += c.segment<3>(modes_ * b + 3).cross(points_.col(s) - centroids_.col(b));
+    if (layout_.turns) force += c.segment<3>(modes_ * b + 3).cross(point_arms_.col(s));
     strengths_.col(s) = (scale_ * point_nodes_(s)) * force;
   }
   between_->Apply(strengths_, &velocity_);  // every point, its own rod's too
@@ -429,7 +447,7 @@ void CoarseLevel::AddZ(const VecX& c, VecX* out) const {
     for (int i = chunk_first_[static_cast<size_t>(a)]; i < chunk_first_[static_cast<size_t>(a) + 1]; ++i) {
       out->segment<3>(3 * i) += c.segment<3>(modes_ * a);
       if (layout_.turns)
-        out->segment<3>(3 * i) += c.segment<3>(modes_ * a + 3).cross(Vec3(offsets_.col(i)));
+        out->segment<3>(3 * i) += c.segment<3>(modes_ * a + 3).cross(Vec3(arms_.col(i)));
     }
 }
 

@@ -1,7 +1,8 @@
 // The coarse level of the two-level preconditioner of the capacitance C = h 𝕄 + S X for the
 // matrix-free mobility (sim/hydro_coupling.h): per rod, K chunks of consecutive nodes, each with
 // a force F (3 modes) or a force and a turn Ω about the chunk's centroid X_b (6 modes: the nodal
-// forces F + Ω × (x_i − X_b)): the columns Z, 3K or 6K per rod; W ≈ C Z and E = Zᵀ W. One
+// forces F + Ω × (x_i − X_b) / ρ_b, ρ_b the chunk's RMS radius, so that a turn's columns are of
+// a force's size): the columns Z, 3K or 6K per rod; W ≈ C Z and E = Zᵀ W. One
 // application of the preconditioner is c = E⁻¹ Zᵀ r, y = Z c + D⁻¹ (r − W c) (D the per-rod
 // blocks).
 //
@@ -9,7 +10,7 @@
 // Between rods, chunk b acts through P points (runs of consecutive nodes, centroids Y_s, N_s nodes
 // each; P = 1: the chunk's centroid), each a regularized point Stokeslet carrying the nodal forces
 // of its nodes,
-//     W_is c = h N_s S_ε(x_i − Y_s) (F_b + Ω_b × (Y_s − X_b)) / (8πμ),
+//     W_is c = h N_s S_ε(x_i − Y_s) (F_b + Ω_b × (Y_s − X_b) / ρ_b) / (8πμ),
 // so W c is a Stokeslet sum of P K per rod sources at M targets (fluid/stokeslet_sum.h: direct,
 // in single precision, or the FMM when it pays): O(M K P R) per application and no 3M × 3K
 // matrix (187 MB for a hundred helices in double) to build or stream. Nodes nearer a point than
@@ -22,7 +23,9 @@
 // exact (docs/performance.md, session 25; GMRES products per step) four chunks with turns against
 // eight with forces alone, the same 24 unknowns per rod: ring10 3.22 → 3.02, lattice20 4.0 → 3.15,
 // lattice50 4.0 → 3.8, lattice100 4.2 → 4.1. They pay for a few tens of rods; from fifty the
-// twice as many points in W's sum cost more than they save (CoarseLayout::For).
+// twice as many points in W's sum cost more than they save (CoarseLayout::For). A chunk on a line
+// (a straight rod) has a turn of zero force; E's turn diagonals carry a thousandth of the force
+// diagonal, which keeps E regular and leaves such a turn at zero.
 #pragma once
 
 #include <memory>
@@ -80,6 +83,9 @@ class CoarseLevel {
   /// Nodes nearer a point of another rod than kNearReach times the point's radius take the
   /// point's own nodes' Stokeslets instead of its centroid's: near_block_ is the difference.
   static constexpr double kNearReach = 2.0;
+  /// E's turn diagonal plus this share of its chunk's force diagonal (a chunk on a line has a
+  /// turn of zero force: Build).
+  static constexpr float kTurnRegularization = 1e-3f;
   /// Build and FindNearPoints with K modes per chunk (fixed-size blocks: 3 or 6).
   template <int K>
   bool BuildWith(const std::vector<CoarseRod>& rods, const std::vector<MatX>& blocks);
@@ -96,7 +102,9 @@ class CoarseLevel {
   std::vector<int> point_chunk_;
   std::vector<int> chunk_first_point_;  ///< first point of each chunk; back() = points
   Matrix3X centroids_;             ///< X_b, per chunk
-  Matrix3X offsets_;               ///< x_i − X_b of each node in its chunk b
+  VecX chunk_radius_;              ///< ρ_b, the RMS distance of chunk b's nodes from X_b (1: one node)
+  Matrix3X arms_;                  ///< (x_i − X_b) / ρ_b of each node in its chunk b
+  Matrix3X point_arms_;            ///< (Y_s − X_b) / ρ_b of each point
   Matrix3X points_;                ///< Y_s, per point
   VecX point_nodes_;               ///< N_s
   VecX point_eps_;                 ///< ε of the point's rod
