@@ -24,4 +24,11 @@ using Matrix3X = Eigen::Matrix<double, 3, Eigen::Dynamic>;
 
 constexpr double kPi = 3.14159265358979323846;
 
+/// [a]×, the cross product's matrix: [a]× b = a × b.
+inline Mat3 CrossMatrix(const Vec3& a) {
+  Mat3 m;
+  m << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;
+  return m;
+}
+
 }  // namespace stokesrods

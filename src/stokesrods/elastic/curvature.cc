@@ -4,11 +4,6 @@
 
 namespace stokesrods {
 
-Mat3 CrossMatrix(const Vec3& a) {
-  Mat3 m;
-  m << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;
-  return m;
-}
 
 StencilCurvature CalcStencilCurvature(const Vec3& e0, const Vec3& e1, bool with_derivatives) {
   StencilCurvature c;

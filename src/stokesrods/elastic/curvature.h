@@ -63,7 +63,4 @@ Vec11 EdgeToStencilGradient(const Vec8& g);
 /// Hessian (or gradient Jacobian) with respect to the stencil DOFs q: Mᵀ H M.
 Mat11 EdgeToStencilHessian(const Mat8& h);
 
-/// 3 × 3 matrix [a]× with [a]× b = a × b.
-Mat3 CrossMatrix(const Vec3& a);
-
 }  // namespace stokesrods

@@ -9,11 +9,6 @@ namespace stokesrods {
 
 namespace {
 
-Mat3 Cross(const Vec3& a) {  // [a]× b = a × b
-  Mat3 m;
-  m << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
-  return m;
-}
 
 }  // namespace
 
@@ -154,7 +149,7 @@ bool CapacitancePreconditioner::BuildFreeBody(const Model& model, double h, int 
     const Place& place = body_place_[static_cast<size_t>(body)];
     auto& [columns, rows] = part(place);
     for (Eigen::Index j = 0; j < surface.points.cols(); ++j) {
-      const Mat3 arm = Cross(surface.points.col(j) - surface.center);
+      const Mat3 arm = CrossMatrix(surface.points.col(j) - surface.center);
       const auto i = place.offset + 3 * j;
       columns.block<3, 3>(i, 0) = h * Mat3::Identity();
       columns.block<3, 3>(i, 3) = -h * arm;

@@ -87,31 +87,24 @@ Mat3 StokesletMatrix(const double t[7]) {
   return s;
 }
 
-// [d]×, the cross product's matrix: [d]× v = d × v.
-Mat3 Cross(const Vec3& d) {
-  Mat3 k;
-  k << 0.0, -d.z(), d.y(), d.z(), 0.0, -d.x(), -d.y(), d.x(), 0.0;
-  return k;
-}
-
-// Z at a node d from its chunk's centroid, 3 × K: [I] (K = 3) or [I, −[d]×] (K = 6: the nodal
-// force F + Ω × d = F − [d]× Ω).
+// Z at a node of arm d (its offset from the chunk's centroid over the chunk's radius), 3 × K: [I]
+// (K = 3) or [I, −[d]×] (K = 6: the nodal force F + Ω × d = F − [d]× Ω).
 template <int K>
 Eigen::Matrix<double, 3, K> ModesAt(const Vec3& d) {
   Eigen::Matrix<double, 3, K> z;
   z.template leftCols<3>().setIdentity();
-  if constexpr (K == 6) z.template rightCols<3>() = -Cross(d);
+  if constexpr (K == 6) z.template rightCols<3>() = -CrossMatrix(d);
   return z;
 }
 
-// Zᵀ b for a node d from its chunk's centroid (K × b's columns): b, or [b; [d]× b].
+// Zᵀ b for a node of arm d (K × b's columns): b, or [b; [d]× b].
 template <int K, class B>
 Eigen::Matrix<double, K, B::ColsAtCompileTime> ModesTransposedTimes(const Vec3& d, const B& b) {
   if constexpr (K == 3) {
     return b;
   } else {
     Eigen::Matrix<double, K, B::ColsAtCompileTime> out;
-    out << b, Cross(d) * b;
+    out << b, CrossMatrix(d) * b;
     return out;
   }
 }
@@ -142,7 +135,6 @@ bool CoarseLevel::Build(const std::vector<CoarseRod>& rods, const std::vector<Ma
   SR_ASSERT(blocks.size() == rods.size(), "one block per rod");
   SR_ASSERT(layout.chunks_per_rod >= 1 && layout.points_per_chunk >= 1, "a chunk and a point per chunk");
   layout_ = layout;
-  modes_ = layout.modes();
   scale_ = scale;
   chunk_first_.clear();
   chunk_rod_.clear();
@@ -202,7 +194,7 @@ bool CoarseLevel::BuildWith(const std::vector<CoarseRod>& rods, const std::vecto
   point_arms_.resize(3, np);
   point_nodes_.resize(np);
   point_eps_.resize(np);
-  std::vector<Block> point_modes(static_cast<size_t>(np));  // scale N_s Z(Y_s − X_b)
+  std::vector<Block> point_modes(static_cast<size_t>(np));  // scale N_s Z((Y_s − X_b) / ρ_b)
   for (int s = 0; s < np; ++s) {
     const int begin = point_first_[static_cast<size_t>(s)], end = point_first_[static_cast<size_t>(s) + 1];
     const int b = point_chunk_[static_cast<size_t>(s)];
@@ -223,7 +215,7 @@ bool CoarseLevel::BuildWith(const std::vector<CoarseRod>& rods, const std::vecto
       for (int j = chunk_first_[static_cast<size_t>(c0 + a)]; j < chunk_first_[static_cast<size_t>(c0 + a) + 1]; ++j) {
         own[r].middleCols<3>(K * a) += blocks[r].middleCols<3>(3 * (j - first));
         if constexpr (K == 6)
-          own[r].middleCols<3>(K * a + 3) -= blocks[r].middleCols<3>(3 * (j - first)).lazyProduct(Cross(arms_.col(j)));
+          own[r].middleCols<3>(K * a + 3) -= blocks[r].middleCols<3>(3 * (j - first)).lazyProduct(CrossMatrix(arms_.col(j)));
       }
   }
 
@@ -235,7 +227,7 @@ bool CoarseLevel::BuildWith(const std::vector<CoarseRod>& rods, const std::vecto
   between_->Build(points_, point_eps_, Matrix3X(x));
   FindNearPoints<K>(x);
 
-  // E = Zᵀ W: W's rows combined over each chunk a (Zᵀ = [I] or [I; [x_i − X_a]×] per node), each
+  // E = Zᵀ W: W's rows combined over each chunk a (Zᵀ = [I] or [I; [x_i − X_a]× / ρ_a] per node), each
   // block in double and kept in single precision (what its LU takes; a double E of a hundred
   // helices is 46 MB fresh at every rebuild). Row by row: within a rod the exact own blocks;
   // between rods chunk a's nodes against every point at once (SumChunkAtPoints; one call per
@@ -275,7 +267,7 @@ bool CoarseLevel::BuildWith(const std::vector<CoarseRod>& rods, const std::vecto
               zs.template bottomRows<3>().setZero();
               for (int d = 0; d < 3; ++d) {
                 for (int k = 0; k < 7; ++k) t[k] = sums(s, 7 + 7 * d + k);
-                zs.template bottomRows<3>() += Cross(Vec3::Unit(d)) * StokesletMatrix(t);
+                zs.template bottomRows<3>() += CrossMatrix(Vec3::Unit(d)) * StokesletMatrix(t);
               }
               zs.template bottomRows<3>() /= chunk_radius_(a);  // the moments of x_i − X_a
             }
@@ -353,8 +345,8 @@ void CoarseLevel::FindNearPoints(const NodeRows& x) {
       const int b = point_chunk_[static_cast<size_t>(s)];
       if (chunk_rod_[static_cast<size_t>(b)] == rod || (p - points_.col(s)).squaredNorm() >= reach2(s))
         continue;
-      // scale (Σ_j S(x_i − x_j) Z(x_j − X_b) − N_s S(x_i − Y_s) Z(Y_s − X_b)) over the point's
-      // nodes j (with forces alone Z = I: the nodes' Stokeslets summed at once).
+      // scale (Σ_j S(x_i − x_j) Z_j − N_s S(x_i − Y_s) Z_s) over the point's nodes j, Z at the
+      // arms of x_j and Y_s (with forces alone Z = I: the nodes' Stokeslets summed at once).
       const int begin = point_first_[static_cast<size_t>(s)], end = point_first_[static_cast<size_t>(s) + 1];
       const double e2 = point_eps_(s) * point_eps_(s);
       Block block;
@@ -393,13 +385,14 @@ void CoarseLevel::FindNearPoints(const NodeRows& x) {
 }
 
 VecX CoarseLevel::Solve(const VecX& v) const {
+  const int modes = layout_.modes();
   const int nc = num_chunks();
-  VecX zv = VecX::Zero(modes_ * nc);
+  VecX zv = VecX::Zero(modes * nc);
   for (int a = 0; a < nc; ++a)
     for (int i = chunk_first_[static_cast<size_t>(a)]; i < chunk_first_[static_cast<size_t>(a) + 1]; ++i) {
       const Vec3 vi = v.segment<3>(3 * i);
-      zv.segment<3>(modes_ * a) += vi;
-      if (layout_.turns) zv.segment<3>(modes_ * a + 3) += Vec3(arms_.col(i)).cross(vi);
+      zv.segment<3>(modes * a) += vi;
+      if (layout_.turns) zv.segment<3>(modes * a + 3) += Vec3(arms_.col(i)).cross(vi);
     }
   Eigen::VectorXf c = zv.cast<float>();
   lu_.Solve(&c);
@@ -407,12 +400,13 @@ VecX CoarseLevel::Solve(const VecX& v) const {
 }
 
 void CoarseLevel::ApplyW(const VecX& c, VecX* out) const {
+  const int modes = layout_.modes();
   const int np = static_cast<int>(point_first_.size()) - 1, m = chunk_first_.back();
   strengths_.resize(3, np);
   for (int s = 0; s < np; ++s) {
     const int b = point_chunk_[static_cast<size_t>(s)];
-    Vec3 force = c.segment<3>(modes_ * b);
-    if (layout_.turns) force += c.segment<3>(modes_ * b + 3).cross(point_arms_.col(s));
+    Vec3 force = c.segment<3>(modes * b);
+    if (layout_.turns) force += c.segment<3>(modes * b + 3).cross(point_arms_.col(s));
     strengths_.col(s) = (scale_ * point_nodes_(s)) * force;
   }
   between_->Apply(strengths_, &velocity_);  // every point, its own rod's too
@@ -425,13 +419,13 @@ void CoarseLevel::ApplyW(const VecX& c, VecX* out) const {
     const int c0 = rod_first_chunk_[static_cast<size_t>(r)];
     const int chunks = rod_first_chunk_[static_cast<size_t>(r) + 1] - c0;
     const Eigen::MatrixXf& own = own_[static_cast<size_t>(r)];
-    SR_ASSERT(own.cols() == modes_ * chunks, "the coarse level's own block does not match its chunks");
-    GemvRowsMixed(own, 0, 3 * n, c.data() + modes_ * c0, out->data() + 3 * first);
+    SR_ASSERT(own.cols() == modes * chunks, "the coarse level's own block does not match its chunks");
+    GemvRowsMixed(own, 0, 3 * n, c.data() + modes * c0, out->data() + 3 * first);
     for (int i = first; i < first + n; ++i) {
       Vec3 u = velocity_.col(i);
       for (int k = near_start_[static_cast<size_t>(i)]; k < near_start_[static_cast<size_t>(i) + 1]; ++k) {
         const int b = point_chunk_[static_cast<size_t>(near_point_[static_cast<size_t>(k)])];
-        const double* block = near_block_.data() + 3 * modes_ * static_cast<std::ptrdiff_t>(k);
+        const double* block = near_block_.data() + 3 * modes * static_cast<std::ptrdiff_t>(k);
         if (layout_.turns)
           u += Eigen::Map<const Eigen::Matrix<double, 3, 6>>(block) * c.segment<6>(6 * b);
         else
@@ -443,11 +437,12 @@ void CoarseLevel::ApplyW(const VecX& c, VecX* out) const {
 }
 
 void CoarseLevel::AddZ(const VecX& c, VecX* out) const {
+  const int modes = layout_.modes();
   for (int a = 0; a < num_chunks(); ++a)
     for (int i = chunk_first_[static_cast<size_t>(a)]; i < chunk_first_[static_cast<size_t>(a) + 1]; ++i) {
-      out->segment<3>(3 * i) += c.segment<3>(modes_ * a);
+      out->segment<3>(3 * i) += c.segment<3>(modes * a);
       if (layout_.turns)
-        out->segment<3>(3 * i) += c.segment<3>(modes_ * a + 3).cross(Vec3(arms_.col(i)));
+        out->segment<3>(3 * i) += c.segment<3>(modes * a + 3).cross(Vec3(arms_.col(i)));
     }
 }
 

@@ -93,7 +93,6 @@ class CoarseLevel {
   void FindNearPoints(const NodeRows& x);
 
   CoarseLayout layout_;
-  int modes_ = 3;
   std::vector<int> chunk_first_;   ///< first global node of each chunk; back() = M
   std::vector<int> chunk_rod_;
   std::vector<int> rod_first_chunk_;  ///< per rod, and back() = chunks
