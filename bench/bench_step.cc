@@ -63,10 +63,16 @@ void BM_RssMobilityAssembly(benchmark::State& st) {
 }
 BENCHMARK(BM_RssMobilityAssembly)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 
-// One rod's elastic assembly: by edges (AddElasticForces) or by the reference path, stencil by
-// stencil (AddElasticForcesPerStencil).
+// One rod's elastic assembly: by edges (AddElasticForces, its stencils on the widest instruction
+// set, on AVX2 or one at a time) or by the reference path, stencil by stencil
+// (AddElasticForcesPerStencil).
 using ElasticAssembly = double (*)(const RodModel&, const VecX&, const RodFrames&, VecX*,
                                    BandedMatrix*);
+template <StencilPath kPath>
+double ByEdges(const RodModel& rod, const VecX& q, const RodFrames& frames, VecX* force,
+               BandedMatrix* hessian) {
+  return AddElasticForces(rod, q, frames, force, hessian, kPath);
+}
 
 void BM_ElasticForcesAndJacobian(benchmark::State& st, ElasticAssembly assemble) {
   const Model model = PaperModel(1, static_cast<int>(st.range(0)), "none", "implicit");
@@ -81,9 +87,14 @@ void BM_ElasticForcesAndJacobian(benchmark::State& st, ElasticAssembly assemble)
   }
   st.SetComplexityN(st.range(0));
 }
-BENCHMARK_CAPTURE(BM_ElasticForcesAndJacobian, by_edges, &AddElasticForces)
+BENCHMARK_CAPTURE(BM_ElasticForcesAndJacobian, by_edges, &ByEdges<StencilPath::kWidest>)
     ->RangeMultiplier(4)->Range(64, 4096)->Complexity(benchmark::oN)
     ->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_ElasticForcesAndJacobian, by_edges_avx2, &ByEdges<StencilPath::kAvx2>)
+    ->Arg(64)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_ElasticForcesAndJacobian, by_edges_portable,
+                  &ByEdges<StencilPath::kPortable>)
+    ->Arg(64)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_ElasticForcesAndJacobian, per_stencil, &AddElasticForcesPerStencil)
     ->Arg(64)->Unit(benchmark::kMicrosecond);
 
@@ -98,8 +109,10 @@ void BM_ElasticForces(benchmark::State& st, ElasticAssembly assemble) {
     benchmark::DoNotOptimize(force.data());
   }
 }
-BENCHMARK_CAPTURE(BM_ElasticForces, by_edges, &AddElasticForces)->Arg(64)
+BENCHMARK_CAPTURE(BM_ElasticForces, by_edges, &ByEdges<StencilPath::kWidest>)->Arg(64)
     ->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_ElasticForces, by_edges_portable, &ByEdges<StencilPath::kPortable>)
+    ->Arg(64)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_ElasticForces, per_stencil, &AddElasticForcesPerStencil)->Arg(64)
     ->Unit(benchmark::kMicrosecond);
 

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <string>
 
 #include <Eigen/LU>
 
@@ -125,14 +126,20 @@ TEST(Jacobian, RotatingHelixInMotion) {
   EXPECT_LT(JacobianError(model, state, 0.01, state.q), 1e-6);
 }
 
-// AddElasticForces (by edges: each edge's terms once, the bending gradient by cross products,
-// the Jacobian gathered in one 8 × 8 matrix per stencil) against AddElasticForcesPerStencil (the
+// AddElasticForces (by edges: each edge's terms once, the stencils' bending and twisting several
+// at a time in vector lanes, elastic/stencil_lanes.h) against AddElasticForcesPerStencil (the
 // energies of elastic/, which tests/elastic/ checks against finite differences): forces, moments
-// and the Jacobian, with the Jacobian and without.
-TEST(ElasticAssembly, ByEdgesAsStencilByStencil) {
+// and the Jacobian, with the Jacobian and without, on each instruction set (the widest the CPU
+// has, AVX2, one stencil at a time; a path the CPU lacks falls back to the next) and on rods
+// whose stencils fill the lanes in whole batches and not (19, 9 and 3 stencils: batches of 8 and
+// 4 lanes with 3, 1 and 3 left over).
+void CompareByEdgesWithStencilByStencil(int nodes, StencilPath path) {
+  std::string toml = kHelix;
+  toml.replace(toml.find("nodes = 21"), 10, "nodes = " + std::to_string(nodes));
+  SCOPED_TRACE(::testing::Message() << nodes << " nodes, path " << static_cast<int>(path));
   // The driven helix after 30 steps (rest curvature and twist, frames transported, twisted),
   // then moved at random by up to a fifth of an edge and twisted by up to 0.5 rad per edge.
-  const Model model = ModelFromToml(kHelix);
+  const Model model = ModelFromToml(toml);
   State state = MakeRestState(model);
   Workspace ws(model);
   for (int k = 0; k < 30; ++k) ASSERT_TRUE(Step(model, 0.01, &state, &ws).ok);
@@ -149,8 +156,8 @@ TEST(ElasticAssembly, ByEdgesAsStencilByStencil) {
     BandedMatrix jacobian_reference(rod.num_dofs(), 10), jacobian(rod.num_dofs(), 10);
     const double energy_reference =
         AddElasticForcesPerStencil(rod, q, frames[0], &reference, &jacobian_reference);
-    const double energy_with = AddElasticForces(rod, q, frames[0], &with, &jacobian);
-    const double energy_without = AddElasticForces(rod, q, frames[0], &without, nullptr);
+    const double energy_with = AddElasticForces(rod, q, frames[0], &with, &jacobian, path);
+    const double energy_without = AddElasticForces(rod, q, frames[0], &without, nullptr, path);
     // The forces on the nodes and the moments on the twist angles, each against its largest.
     for (const bool moments : {false, true}) {
       double scale = 0.0, error = 0.0;
@@ -174,7 +181,7 @@ TEST(ElasticAssembly, ByEdgesAsStencilByStencil) {
     BandedMatrix soft_reference(rod.num_dofs(), 10), soft_jacobian(rod.num_dofs(), 10);
     VecX scratch = VecX::Zero(model.num_dofs);
     AddElasticForcesPerStencil(soft, q, frames[0], &scratch, &soft_reference);
-    AddElasticForces(soft, q, frames[0], &scratch, &soft_jacobian);
+    AddElasticForces(soft, q, frames[0], &scratch, &soft_jacobian, path);
     const MatX soft_dense = soft_reference.ToDense();
     const double soft_error = (soft_jacobian.ToDense() - soft_dense).cwiseAbs().maxCoeff() /
                               soft_dense.cwiseAbs().maxCoeff();
@@ -185,6 +192,11 @@ TEST(ElasticAssembly, ByEdgesAsStencilByStencil) {
     EXPECT_NEAR(energy_with, energy_reference, 1e-12 * energy_reference);
     EXPECT_NEAR(energy_without, energy_reference, 1e-12 * energy_reference);
   }
+}
+
+TEST(ElasticAssembly, ByEdgesAsStencilByStencil) {
+  for (const StencilPath path : {StencilPath::kWidest, StencilPath::kAvx2, StencilPath::kPortable})
+    for (const int nodes : {21, 11, 5}) CompareByEdgesWithStencilByStencil(nodes, path);
 }
 
 // The implicit RSS drag couples everything. With f eliminated exactly (f = −𝕄⁻¹U), Newton's

@@ -1,0 +1,78 @@
+// BendTwistStencils' loop over batches of W stencils in the lanes of V (a GCC vector of W
+// doubles, or double with W = 1), for the translation units of each instruction set
+// (stencil_batch*.cc): internal linkage, as stencil_lanes.h.
+#pragma once
+
+#include <algorithm>
+#include <cstring>
+
+#include "stokesrods/elastic/stencil_batch.h"
+#include "stokesrods/elastic/stencil_lanes.h"
+
+namespace stokesrods {
+namespace {
+
+// W consecutive values of a column from `first` into the lanes; past `lanes` the last one again
+// (the spare lanes compute a valid stencil whose results are dropped).
+template <class V, int W>
+V LoadLanes(const double* column, int first, int lanes) {
+  double values[W];
+  for (int k = 0; k < W; ++k) values[k] = column[first + std::min(k, lanes - 1)];
+  V v;
+  std::memcpy(&v, values, sizeof(V));
+  return v;
+}
+
+template <class V, int W>
+L3<V> LoadLanes3(const double* const* columns, int first, int lanes) {
+  return {LoadLanes<V, W>(columns[0], first, lanes), LoadLanes<V, W>(columns[1], first, lanes),
+          LoadLanes<V, W>(columns[2], first, lanes)};
+}
+
+template <class V, int W>
+void StencilBatches(const StencilColumns& in, int count, bool with_jacobian,
+                    StencilResults* out) {
+  static_assert(sizeof(V) == W * sizeof(double));
+  out->energy.resize(static_cast<size_t>(count));
+  out->gradient.resize(static_cast<size_t>(11 * count));
+  if (with_jacobian) out->jacobian.resize(static_cast<size_t>(121 * count));
+  for (int s = 0; s < count; s += W) {
+    const int lanes = std::min(W, count - s);
+    StencilIn<V> lane_in;
+    lane_in.e0 = LoadLanes3<V, W>(in.edge, s, lanes);
+    lane_in.e1 = LoadLanes3<V, W>(in.edge, s + 1, lanes);
+    lane_in.l0 = LoadLanes<V, W>(in.length, s, lanes);
+    lane_in.l1 = LoadLanes<V, W>(in.length, s + 1, lanes);
+    lane_in.m1a = LoadLanes3<V, W>(in.m1, s, lanes);
+    lane_in.m2a = LoadLanes3<V, W>(in.m2, s, lanes);
+    lane_in.m1b = LoadLanes3<V, W>(in.m1, s + 1, lanes);
+    lane_in.m2b = LoadLanes3<V, W>(in.m2, s + 1, lanes);
+    lane_in.kb = LoadLanes3<V, W>(in.curvature_binormal, s, lanes);
+    lane_in.d = LoadLanes<V, W>(in.denominator, s, lanes);
+    lane_in.excess1 = LoadLanes<V, W>(in.excess[0], s, lanes);
+    lane_in.excess2 = LoadLanes<V, W>(in.excess[1], s, lanes);
+    lane_in.bend = LoadLanes<V, W>(in.bend, s, lanes);
+    lane_in.twist_stiffness = LoadLanes<V, W>(in.twist_stiffness, s, lanes);
+    lane_in.twist = LoadLanes<V, W>(in.twist, s, lanes);
+    V energy, gradient[11], jacobian[121];
+    if (with_jacobian)
+      BendTwistStencil<true>(lane_in, &energy, gradient, jacobian);
+    else
+      BendTwistStencil<false>(lane_in, &energy, gradient, jacobian);
+    // The lanes out by stencil (V[i] holds stencil k's value i in lane k).
+    double e[W], g[11 * W], j[121 * W];
+    std::memcpy(e, &energy, sizeof(energy));
+    std::memcpy(g, gradient, sizeof(gradient));
+    if (with_jacobian) std::memcpy(j, jacobian, sizeof(jacobian));
+    for (int k = 0; k < lanes; ++k) {
+      const auto stencil = static_cast<size_t>(s + k);
+      out->energy[stencil] = e[k];
+      for (int i = 0; i < 11; ++i) out->gradient[11 * stencil + i] = g[W * i + k];
+      if (with_jacobian)
+        for (int i = 0; i < 121; ++i) out->jacobian[121 * stencil + i] = j[W * i + k];
+    }
+  }
+}
+
+}  // namespace
+}  // namespace stokesrods
