@@ -37,13 +37,15 @@ double AddElasticForcesByEdge(const RodModel& rod, const VecX& q, const RodFrame
   const int o = rod.dof_offset;
   auto x = [&](int i) { return Vec3(q.segment<3>(o + NodeDof(i))); };
   double energy = 0.0;
-  // Kept: no allocation per evaluation. Columns of the edges (e, |e|, m1, m2: 10) and of the
-  // stencils (κb, D, Δκ, EI/Δl, GJ/Δl, Δτ: 9).
+  // Kept: no allocation per evaluation. Columns of the edges and of the stencils, by first column:
+  enum EdgeColumn { kEdge = 0, kLength = 3, kM1 = 4, kM2 = 7, kEdgeColumns = 10 };
+  enum StencilColumn { kKb = 0, kD = 3, kExcess = 4, kBend = 6, kTwistStiffness = 7, kTwist = 8,
+                       kStencilColumns = 9 };
   thread_local std::vector<double> edge_columns, stencil_columns;
   thread_local StencilResults results;
   const auto edges = static_cast<size_t>(n - 1), stencils = static_cast<size_t>(std::max(n - 2, 0));
-  edge_columns.resize(10 * edges);
-  stencil_columns.resize(9 * stencils);
+  edge_columns.resize(kEdgeColumns * edges);
+  stencil_columns.resize(kStencilColumns * stencils);
   auto edge_column = [&](int k) { return edge_columns.data() + k * edges; };
   auto stencil_column = [&](int k) { return stencil_columns.data() + k * stencils; };
   Vec6 g6;
@@ -53,11 +55,11 @@ double AddElasticForcesByEdge(const RodModel& rod, const VecX& q, const RodFrame
     Vec3 m1, m2;
     MaterialFrame(frames.frames[static_cast<size_t>(j)], q(o + TwistDof(j)), &m1, &m2);
     for (int c = 0; c < 3; ++c) {
-      edge_column(c)[j] = e[c];
-      edge_column(4 + c)[j] = m1[c];
-      edge_column(7 + c)[j] = m2[c];
+      edge_column(kEdge + c)[j] = e[c];
+      edge_column(kM1 + c)[j] = m1[c];
+      edge_column(kM2 + c)[j] = m2[c];
     }
-    edge_column(3)[j] = e.norm();
+    edge_column(kLength)[j] = e.norm();
     energy += StretchingEnergy({rod.axial_stiffness, rod.rest_edge_length(j)}, x(j), x(j + 1),
                                &g6, hessian ? &h6 : nullptr);
     force->segment<3>(o + NodeDof(j)) -= g6.head<3>();
@@ -72,38 +74,40 @@ double AddElasticForcesByEdge(const RodModel& rod, const VecX& q, const RodFrame
     const int s = i - 1;
     // κb and Δκ in the arithmetic of the rest curvature (MaterialCurvatures), so that they vanish
     // exactly at rest; the lanes take them from here.
-    const Vec3 e0 = edge_vector(0, s), e1 = edge_vector(0, i);
-    const double d = edge_column(3)[s] * edge_column(3)[i] + e0.dot(e1);
-    SR_DASSERT(d > 1e-14 * edge_column(3)[s] * edge_column(3)[i],
+    const Vec3 e0 = edge_vector(kEdge, s), e1 = edge_vector(kEdge, i);
+    const double l0 = edge_column(kLength)[s], l1 = edge_column(kLength)[i];
+    const double d = l0 * l1 + e0.dot(e1);
+    SR_DASSERT(d > 1e-14 * l0 * l1,
                "curvature binormal of anti-parallel edges");
     const Vec3 kb = (2.0 / d) * e0.cross(e1);
-    const Vec3 m1 = edge_vector(4, s) + edge_vector(4, i), m2 = edge_vector(7, s) + edge_vector(7, i);
+    const Vec3 m1 = edge_vector(kM1, s) + edge_vector(kM1, i);
+    const Vec3 m2 = edge_vector(kM2, s) + edge_vector(kM2, i);
     const Vec2 excess =
         Vec2(0.5 * m2.dot(kb), -0.5 * m1.dot(kb)) - rod.rest_curvature[static_cast<size_t>(i)];
     const double dl = rod.rest_voronoi_length(i);
-    for (int c = 0; c < 3; ++c) stencil_column(c)[s] = kb[c];
-    stencil_column(3)[s] = d;
-    stencil_column(4)[s] = excess[0];
-    stencil_column(5)[s] = excess[1];
-    stencil_column(6)[s] = rod.bending_stiffness / dl;
-    stencil_column(7)[s] = rod.twisting_stiffness / dl;
-    stencil_column(8)[s] = q(o + TwistDof(i)) - q(o + TwistDof(i - 1)) +
-                           frames.reference_twist(i) - rod.rest_twist(i);
+    for (int c = 0; c < 3; ++c) stencil_column(kKb + c)[s] = kb[c];
+    stencil_column(kD)[s] = d;
+    stencil_column(kExcess)[s] = excess[0];
+    stencil_column(kExcess + 1)[s] = excess[1];
+    stencil_column(kBend)[s] = rod.bending_stiffness / dl;
+    stencil_column(kTwistStiffness)[s] = rod.twisting_stiffness / dl;
+    stencil_column(kTwist)[s] = q(o + TwistDof(i)) - q(o + TwistDof(i - 1)) +
+                                frames.reference_twist(i) - rod.rest_twist(i);
   }
   StencilColumns in;
   for (int c = 0; c < 3; ++c) {
-    in.edge[c] = edge_column(c);
-    in.m1[c] = edge_column(4 + c);
-    in.m2[c] = edge_column(7 + c);
-    in.curvature_binormal[c] = stencil_column(c);
+    in.edge[c] = edge_column(kEdge + c);
+    in.m1[c] = edge_column(kM1 + c);
+    in.m2[c] = edge_column(kM2 + c);
+    in.curvature_binormal[c] = stencil_column(kKb + c);
   }
-  in.length = edge_column(3);
-  in.denominator = stencil_column(3);
-  in.excess[0] = stencil_column(4);
-  in.excess[1] = stencil_column(5);
-  in.bend = stencil_column(6);
-  in.twist_stiffness = stencil_column(7);
-  in.twist = stencil_column(8);
+  in.length = edge_column(kLength);
+  in.denominator = stencil_column(kD);
+  in.excess[0] = stencil_column(kExcess);
+  in.excess[1] = stencil_column(kExcess + 1);
+  in.bend = stencil_column(kBend);
+  in.twist_stiffness = stencil_column(kTwistStiffness);
+  in.twist = stencil_column(kTwist);
   BendTwistStencils(in, static_cast<int>(stencils), hessian != nullptr, &results, path);
   for (int i = 1; i + 1 < n; ++i) {
     const auto s = static_cast<size_t>(i - 1);
