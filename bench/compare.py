@@ -5,9 +5,11 @@ On a shared, noisy machine the same binary can run 30 % slower from one minute t
 change is measured against its baseline run for run: each round runs every case with the
 baseline and the candidate one right after the other, in alternating order (baseline first in
 odd rounds, candidate first in even ones), and the table gives per case the median over the
-rounds of each, their ranges, the ratio of the medians (candidate / baseline) and the range of
-the rounds' own ratios, with the work counted per step (Newton iterations, GMRES products),
-which does not depend on the host. Baseline and candidate differ by their binary (a build of
+rounds of each, their ranges, the ratio of the medians (candidate / baseline), the range and
+the median of the rounds' own ratios (each round's pair ran seconds apart) and the ratio of the
+two sides' minima (the host's noise only adds time, so each side's fastest run is the one it
+disturbed least), with the work counted per step (Newton iterations, GMRES products), which does
+not depend on the host. Baseline and candidate differ by their binary (a build of
 the commit before the change, e.g. in a git worktree), by settings (--set-candidate), or both.
 See bench/README.md.
 
@@ -105,7 +107,8 @@ def main():
     print(f"Load average at end: {run_table.load_text(os.getloadavg())}")
     head = ["case", "threads", "baseline ms/step (median, range)",
             "candidate ms/step (median, range)", "candidate / baseline", "rounds' ratios",
-            "Newton it./step", "GMRES products/step"]
+            "median of the rounds' ratios", "ratio of the minima", "Newton it./step",
+            "GMRES products/step"]
     print("| " + " | ".join(head) + " |")
     print("|" + " --- |" * len(head))
     fmt = run_table.fmt_num
@@ -115,7 +118,7 @@ def main():
             failed = [r for r in a + b if not r["ok"]]
             if failed:
                 print(f"| {case} | {threads} | **{failed[0].get('side')}: "
-                      f"{failed[0].get('message', 'failed')}** | | | | | |")
+                      f"{failed[0].get('message', 'failed')}** |" + " |" * (len(head) - 3))
                 continue
             sa, sb = summary(a), summary(b)
             ratios = sorted(y["ms_per_step_median"] / x["ms_per_step_median"]
@@ -125,6 +128,7 @@ def main():
                      f"{fmt(sb['median'])} ({fmt(sb['low'])}–{fmt(sb['high'])})",
                      fmt(sb["median"] / sa["median"]),
                      f"{fmt(ratios[0])}–{fmt(ratios[-1])}",
+                     fmt(statistics.median(ratios)), fmt(sb["low"] / sa["low"]),
                      f"{fmt(sa['newton'], 2)} → {fmt(sb['newton'], 2)}",
                      f"{fmt(sa['products'], 2)} → {fmt(sb['products'], 2)}"]
             print("| " + " | ".join(cells) + " |")
