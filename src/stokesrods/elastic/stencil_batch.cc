@@ -9,24 +9,23 @@
 
 namespace stokesrods {
 
-#if defined(__x86_64__)
-void BendTwistStencilsAvx512(const StencilColumns& in, int count, bool with_jacobian,
-                             StencilResults* out);
-void BendTwistStencilsAvx2(const StencilColumns& in, int count, bool with_jacobian,
-                           StencilResults* out);
-#endif
-
 void BendTwistStencils(const StencilColumns& in, int count, bool with_jacobian,
                        StencilResults* out, StencilPath path) {
+  out->energy.resize(static_cast<size_t>(count));
+  out->gradient.resize(static_cast<size_t>(11 * count));
+  if (with_jacobian) out->jacobian.resize(static_cast<size_t>(121 * count));
+  double* const energy = out->energy.data();
+  double* const gradient = out->gradient.data();
+  double* const jacobian = with_jacobian ? out->jacobian.data() : nullptr;
 #if defined(__x86_64__)
   static const bool has_avx512 = __builtin_cpu_supports("avx512f");
   static const bool has_avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
   if (path == StencilPath::kWidest && has_avx512)
-    return BendTwistStencilsAvx512(in, count, with_jacobian, out);
+    return BendTwistStencilsAvx512(in, count, with_jacobian, energy, gradient, jacobian);
   if (path != StencilPath::kPortable && has_avx2)
-    return BendTwistStencilsAvx2(in, count, with_jacobian, out);
+    return BendTwistStencilsAvx2(in, count, with_jacobian, energy, gradient, jacobian);
 #endif
-  StencilBatches<double, 1>(in, count, with_jacobian, out);
+  StencilBatches<double, 1>(in, count, with_jacobian, energy, gradient, jacobian);
 }
 
 }  // namespace stokesrods

@@ -7,8 +7,8 @@ namespace stokesrods {
 using Lanes4 = double __attribute__((vector_size(32)));
 
 void BendTwistStencilsAvx2(const StencilColumns& in, int count, bool with_jacobian,
-                           StencilResults* out) {
-  StencilBatches<Lanes4, 4>(in, count, with_jacobian, out);
+                           double* energy, double* gradient, double* jacobian) {
+  StencilBatches<Lanes4, 4>(in, count, with_jacobian, energy, gradient, jacobian);
 }
 
 }  // namespace stokesrods

@@ -7,8 +7,8 @@ namespace stokesrods {
 using Lanes8 = double __attribute__((vector_size(64)));
 
 void BendTwistStencilsAvx512(const StencilColumns& in, int count, bool with_jacobian,
-                             StencilResults* out) {
-  StencilBatches<Lanes8, 8>(in, count, with_jacobian, out);
+                             double* energy, double* gradient, double* jacobian) {
+  StencilBatches<Lanes8, 8>(in, count, with_jacobian, energy, gradient, jacobian);
 }
 
 }  // namespace stokesrods

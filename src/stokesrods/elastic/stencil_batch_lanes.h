@@ -1,12 +1,10 @@
 // BendTwistStencils' loop over batches of W stencils in the lanes of V (a GCC vector of W
 // doubles, or double with W = 1), for the translation units of each instruction set
-// (stencil_batch*.cc): internal linkage, as stencil_lanes.h.
+// (stencil_batch*.cc): internal linkage, as stencil_lanes.h, and nothing from the standard
+// library (stencil_columns.h).
 #pragma once
 
-#include <algorithm>
-#include <cstring>
-
-#include "stokesrods/elastic/stencil_batch.h"
+#include "stokesrods/elastic/stencil_columns.h"
 #include "stokesrods/elastic/stencil_lanes.h"
 
 namespace stokesrods {
@@ -17,9 +15,9 @@ namespace {
 template <class V, int W>
 V LoadLanes(const double* column, int first, int lanes) {
   double values[W];
-  for (int k = 0; k < W; ++k) values[k] = column[first + std::min(k, lanes - 1)];
+  for (int k = 0; k < W; ++k) values[k] = column[first + (k < lanes ? k : lanes - 1)];
   V v;
-  std::memcpy(&v, values, sizeof(V));
+  __builtin_memcpy(&v, values, sizeof(V));
   return v;
 }
 
@@ -29,15 +27,13 @@ L3<V> LoadLanes3(const double* const* columns, int first, int lanes) {
           LoadLanes<V, W>(columns[2], first, lanes)};
 }
 
+// The outputs as BendTwistStencilsAvx512's (stencil_columns.h), sized by the caller.
 template <class V, int W>
-void StencilBatches(const StencilColumns& in, int count, bool with_jacobian,
-                    StencilResults* out) {
+void StencilBatches(const StencilColumns& in, int count, bool with_jacobian, double* energy_out,
+                    double* gradient_out, double* jacobian_out) {
   static_assert(sizeof(V) == W * sizeof(double));
-  out->energy.resize(static_cast<size_t>(count));
-  out->gradient.resize(static_cast<size_t>(11 * count));
-  if (with_jacobian) out->jacobian.resize(static_cast<size_t>(121 * count));
   for (int s = 0; s < count; s += W) {
-    const int lanes = std::min(W, count - s);
+    const int lanes = count - s < W ? count - s : W;
     StencilIn<V> lane_in;
     lane_in.e0 = LoadLanes3<V, W>(in.edge, s, lanes);
     lane_in.e1 = LoadLanes3<V, W>(in.edge, s + 1, lanes);
@@ -61,15 +57,15 @@ void StencilBatches(const StencilColumns& in, int count, bool with_jacobian,
       BendTwistStencil<false>(lane_in, &energy, gradient, jacobian);
     // The lanes out by stencil (V[i] holds stencil k's value i in lane k).
     double e[W], g[11 * W], j[121 * W];
-    std::memcpy(e, &energy, sizeof(energy));
-    std::memcpy(g, gradient, sizeof(gradient));
-    if (with_jacobian) std::memcpy(j, jacobian, sizeof(jacobian));
+    __builtin_memcpy(e, &energy, sizeof(energy));
+    __builtin_memcpy(g, gradient, sizeof(gradient));
+    if (with_jacobian) __builtin_memcpy(j, jacobian, sizeof(jacobian));
     for (int k = 0; k < lanes; ++k) {
-      const auto stencil = static_cast<size_t>(s + k);
-      out->energy[stencil] = e[k];
-      for (int i = 0; i < 11; ++i) out->gradient[11 * stencil + i] = g[W * i + k];
+      const int stencil = s + k;
+      energy_out[stencil] = e[k];
+      for (int i = 0; i < 11; ++i) gradient_out[11 * stencil + i] = g[W * i + k];
       if (with_jacobian)
-        for (int i = 0; i < 121; ++i) out->jacobian[121 * stencil + i] = j[W * i + k];
+        for (int i = 0; i < 121; ++i) jacobian_out[121 * stencil + i] = j[W * i + k];
     }
   }
 }
