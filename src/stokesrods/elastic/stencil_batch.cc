@@ -5,15 +5,17 @@
 // rod of 65 nodes): see docs/performance.md, session 28.
 #include "stokesrods/elastic/stencil_batch.h"
 
+#include <cstddef>
+
 #include "stokesrods/elastic/stencil_batch_lanes.h"
 
 namespace stokesrods {
 
 void BendTwistStencils(const StencilColumns& in, int count, bool with_jacobian,
                        StencilResults* out, StencilPath path) {
-  out->energy.resize(static_cast<size_t>(count));
-  out->gradient.resize(static_cast<size_t>(11 * count));
-  if (with_jacobian) out->jacobian.resize(static_cast<size_t>(121 * count));
+  out->energy.resize(static_cast<std::size_t>(count));
+  out->gradient.resize(static_cast<std::size_t>(11 * count));
+  if (with_jacobian) out->jacobian.resize(static_cast<std::size_t>(121 * count));
   double* const energy = out->energy.data();
   double* const gradient = out->gradient.data();
   double* const jacobian = with_jacobian ? out->jacobian.data() : nullptr;
