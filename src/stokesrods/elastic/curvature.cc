@@ -4,7 +4,6 @@
 
 namespace stokesrods {
 
-
 StencilCurvature CalcStencilCurvature(const Vec3& e0, const Vec3& e1, bool with_derivatives) {
   StencilCurvature c;
   c.e0 = e0;

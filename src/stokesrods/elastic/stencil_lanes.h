@@ -81,7 +81,6 @@ struct StencilIn {
 /// rest has a bending force of exactly zero on every instruction set.
 template <bool kJacobian, class T>
 void BendTwistStencil(const StencilIn<T>& s, T* energy, T* gradient, T* jacobian) {
-  const L3<T> n = Cross(s.e0, s.e1);
   const L3<T>& kb = s.kb;
   const T inv_d = 1.0 / s.d;
   const L3<T> m1 = s.m1a + s.m1b, m2 = s.m2a + s.m2b;
@@ -152,7 +151,7 @@ void BendTwistStencil(const StencilIn<T>& s, T* energy, T* gradient, T* jacobian
   T e[6][6];
   {
     const L3<T> wp = u0 + u1;
-    const T f = Dot(wp, n);
+    const T f = Dot(wp, Cross(s.e0, s.e1));  // w'·n
     const L3<T> gf0 = Cross(s.e1, wp), gf1 = Cross(wp, s.e0);
     const T gf[6] = {gf0.x, gf0.y, gf0.z, gf1.x, gf1.y, gf1.z};
     const T inv_d2 = inv_d * inv_d;

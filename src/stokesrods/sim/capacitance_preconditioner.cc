@@ -7,11 +7,6 @@
 
 namespace stokesrods {
 
-namespace {
-
-
-}  // namespace
-
 VecX CapacitancePreconditioner::Block::Gather(const VecX& v) const {
   VecX x(size);
   int k = 0;
