@@ -11,8 +11,17 @@
 // d_box the distance between the group's bounding box and the chunk's (which holds its segments;
 // leaving ε² out makes the test conservative), the maximum over the chunk's segments.
 // Near segments (δ < NearRadius(n)) only occur in chunks that fail this test for every k < n, so
-// they keep the n-point rule that the near corrections subtract. Ten helices on a ring 3R apart
-// take n = 3 (ChooseSplitByCost), and most of the other rods' chunks are far enough for 2.
+// they keep the n-point rule. Ten helices on a ring 3R apart take n = 3 (ChooseSplitByCost), and
+// most of the other rods' chunks are far enough for 2.
+//
+// The near pairs are left out of the sum (Build's `excluded`): their near corrections carry the
+// closed forms alone, instead of the closed forms minus the rule that the sum would add. The two
+// agree to rounding, but the rule's terms at the nearest pairs are the largest of the sum, and in
+// single precision their rounding (≈ 1e-7 of each, different at every step as the rods move) was
+// the step-to-step noise of the operator that the drag's extrapolation amplifies into GMRES's
+// right-hand side (docs/performance.md, sessions 26, 29 and 30). The targets are summed K at a
+// time over shared ranges of sources (point_stokeslet.h); the union of the K targets' left-out
+// points is cut from those ranges and summed for each target alone, without its own.
 // Used where the far sum is direct (the FMM sums one set of points, and its tree replaces the
 // distant pairs anyway).
 #pragma once
@@ -35,18 +44,23 @@ class FarRuleSum {
   /// Segment s runs from nodes.col(first_node[s]) to the next column, with blob size eps[s]; rod
   /// r's segments are [rod_first_segment[r], rod_first_segment[r + 1]). points: the split's n
   /// (≥ 2); accuracy: its tolerance (NearRadius); single: kernel sums in single precision
-  /// (kSinglePrecisionTolerance). The targets are the nodes.
+  /// (kSinglePrecisionTolerance). The targets are the nodes. excluded (optional, one sorted list
+  /// per node): the segments whose n-point rule the sum leaves out at that node (its near
+  /// segments: δ < NearRadius(n), so their chunks are on the n-point rule, which is checked).
   void Build(const Matrix3X& nodes, const std::vector<int>& first_node, const VecX& eps,
-             const std::vector<int>& rod_first_segment, int points, double accuracy, bool single);
+             const std::vector<int>& rod_first_segment, int points, double accuracy, bool single,
+             const std::vector<std::vector<int>>* excluded = nullptr);
 
   /// w (3 × M) = Σ_segments Σ_q w_q L S_ε(x_t − y_q) ((1 − α_q) f_a + α_q f_b), each rod with the
   /// rule Build chose for the target's group; density: the nodal force densities f (3 × M).
   void Apply(const Matrix3X& density, Matrix3X* w) const;
 
-  /// Kernel evaluations per Apply; the same sum with n points everywhere would take
-  /// pairs_at_n() (for the tests and the bench).
+  /// Kernel evaluations per Apply; the same sum with n points everywhere (and no pair left out)
+  /// would take pairs_at_n() (for the tests and the bench); excluded_pairs(): the (node, rule
+  /// point) pairs left out.
   std::int64_t pairs() const { return pairs_; }
   std::int64_t pairs_at_n() const { return pairs_at_n_; }
+  std::int64_t excluded_pairs() const { return excluded_pairs_; }
 
  private:
   struct Rule {
@@ -65,11 +79,13 @@ class FarRuleSum {
   Eigen::Matrix3Xf targets_f_;    // relative to the nodes' mean (single precision)
   mutable MatX src_;              // sources × 7 (x, y, z, ε², g): g of the last Apply in double
   mutable Eigen::MatrixXf src_f_; // single precision: positions relative to that mean, and g
-  // Per group g of targets [g kGroupTargets, …): its source ranges range_[range_start_[g] …),
-  // each one or more consecutive chunks on one rule.
-  std::vector<int> range_start_;
-  std::vector<SourceRange> range_;
-  std::int64_t pairs_ = 0, pairs_at_n_ = 0;
+  // Per pass p over kPointSumTargets consecutive targets (the passes of a group one after the
+  // other): the source ranges all its targets take, range_[range_start_[p] …), each one or more
+  // consecutive chunks on one rule minus the pass's left-out points; per target t, the rest of
+  // those points but its own, own_range_[own_start_[t] …).
+  std::vector<int> range_start_, own_start_;
+  std::vector<SourceRange> range_, own_range_;
+  std::int64_t pairs_ = 0, pairs_at_n_ = 0, excluded_pairs_ = 0;
 };
 
 }  // namespace stokesrods

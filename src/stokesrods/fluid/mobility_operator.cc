@@ -156,6 +156,8 @@ void PackNearBlocks(const std::vector<std::vector<std::pair<int, Mat3>>>& per_ta
 //           + Σ_near (A_a − A_a^Gauss) f_a + (A_b − A_b^Gauss) f_b,       (exact minus the rule)
 // where the first sum runs over all segments (the fast sum) and the second corrects the near
 // pairs to the closed forms. The corrections are stored per target as 3×3 blocks acting on F.
+// Where the far rule sum serves (exclude_near_), its first sum leaves the near pairs out and the
+// corrections are the closed forms A_a, A_b alone (fluid/far_rule_sum.h).
 class MatrixFreeRssMobility final : public MobilityOperator {
  public:
   // One accuracy at every size: the far field is as accurate as the fast sum's tolerance, so the
@@ -174,6 +176,7 @@ class MatrixFreeRssMobility final : public MobilityOperator {
              .direct_below_pairs = static_cast<std::int64_t>(options.direct_sum_below),
              .choose_by_cost = options.fast_sum_by_cost})),
         far_rule_by_distance_(options.far_rule_by_distance),
+        exclude_near_from_far_(options.exclude_near_from_far_sum),
         single_far_(options.fast_sum_tolerance >= kSinglePrecisionTolerance),
         reuse_near_(single_far_ && options.reuse_tolerance > 0.0),
         near_reuse_(reuse_near_ ? options.reuse_tolerance : 0.0,
@@ -239,11 +242,18 @@ class MatrixFreeRssMobility final : public MobilityOperator {
     std::vector<double> table;
     std::vector<char> is_near;
   };
-  // Rod r's rows of exact closed forms minus the far rule, at its nodes x (kept by reference).
-  RssRowKernel RowKernel(int r, const Matrix3X& x) const {
+  // Rod r's rows of exact closed forms, minus the far rule where `subtract_rule` (the far sum
+  // adds it at the pair), at its nodes x (kept by reference).
+  RssRowKernel RowKernel(int r, const Matrix3X& x, bool subtract_rule) const {
     return RssRowKernel(x, params_.regularization * rods_[static_cast<size_t>(r)].radius,
-                        accuracy_, split_.gauss_points);
+                        accuracy_, subtract_rule ? split_.gauss_points : 0);
   }
+  // The near blocks at `targets` (each with its near segments into `segments`, if given).
+  void NearBlocksOf(const Matrix3X& targets, bool subtract_rule, NearBlocks* blocks,
+                    std::vector<std::vector<int>>* segments) const;
+  // The far sum by FarRuleSum, its near pairs left out where exclude_near_ (the near segments of
+  // the last near blocks at the nodes).
+  void BuildRuleSum();
   // (kernels and inverse_voronoi (1/Λ_j) of one geometry, the one p is taken from)
   void NearPairBlocks(const Vec3& p, const std::vector<int>& near,
                       const std::vector<RssRowKernel>& kernels, const VecX& inverse_voronoi,
@@ -262,9 +272,17 @@ class MatrixFreeRssMobility final : public MobilityOperator {
   // Where far_ sums directly and the split has more than 2 points: the far field with fewer
   // points on the rods far from each group of targets (fluid/far_rule_sum.h), used instead.
   bool far_rule_by_distance_;
+  bool exclude_near_from_far_;      // MobilityOptions::exclude_near_from_far_sum
   bool single_far_;                 // the far sum in single precision (kSinglePrecisionTolerance)
   bool use_rule_sum_ = false;
   FarRuleSum rule_sum_;
+  // Where the rule sum serves: the nodes' near pairs are left out of it, and their near blocks
+  // are the closed forms alone (fluid/far_rule_sum.h: the rule's rounding at the nearest pairs).
+  bool exclude_near_ = false;
+  // The near segments of each node of the last near blocks computed without the reuse (with it,
+  // near_segments_), and which of the two holds the current ones.
+  std::vector<std::vector<int>> own_near_segments_;
+  bool near_lists_in_reuse_ = false;
   std::vector<HydroRod> rods_;
   Matrix3X nodes_;                  // 3 × M
   VecX inverse_voronoi_;            // 1/Λ_j
@@ -335,7 +353,10 @@ void MatrixFreeRssMobility::ChooseSplitByCost() {
     BuildSplit(false);
   }
   ForgetNearHistory();
-  if (reuse_near_) UpdateNearBlocks();  // the chosen split's blocks start the reuse's history
+  if (reuse_near_) {  // the chosen split's blocks start the reuse's history
+    UpdateNearBlocks();
+    BuildRuleSum();
+  }
 }
 
 void MatrixFreeRssMobility::BuildSplit(bool reuse) {
@@ -353,18 +374,27 @@ void MatrixFreeRssMobility::BuildSplit(bool reuse) {
     }
   }
   far_->Build(gauss_points_, gauss_eps_, nodes_);
-  if (reuse)
+  use_rule_sum_ = far_rule_by_distance_ && g > 2 && far_->Stats().far_pairs == 0;
+  const bool exclude = use_rule_sum_ && exclude_near_from_far_;
+  if (exclude != exclude_near_) ForgetNearHistory();  // its blocks were of the other kind
+  exclude_near_ = exclude;
+  if (reuse) {
     UpdateNearBlocks();
-  else
-    FindNearBlocks(nodes_, &near_);
-  const StokesletSumStats far = far_->Stats();
-  use_rule_sum_ = far_rule_by_distance_ && g > 2 && far.far_pairs == 0;
-  if (use_rule_sum_) {
-    std::vector<int> first_node, rod_first_segment;
-    VecX eps;
-    SegmentLists(&first_node, &eps, &rod_first_segment);
-    rule_sum_.Build(nodes_, first_node, eps, rod_first_segment, g, accuracy_, single_far_);
+  } else {
+    NearBlocksOf(nodes_, !exclude_near_, &near_, &own_near_segments_);
+    near_lists_in_reuse_ = false;
   }
+  BuildRuleSum();
+}
+
+void MatrixFreeRssMobility::BuildRuleSum() {
+  if (!use_rule_sum_) return;
+  std::vector<int> first_node, rod_first_segment;
+  VecX eps;
+  SegmentLists(&first_node, &eps, &rod_first_segment);
+  const std::vector<std::vector<int>>& near = near_lists_in_reuse_ ? near_segments_ : own_near_segments_;
+  rule_sum_.Build(nodes_, first_node, eps, rod_first_segment, split_.gauss_points, accuracy_,
+                  single_far_, exclude_near_ ? &near : nullptr);
 }
 
 // The near pairs by NearSegmentSearch (fluid/near_search.h: boxes per rod and per run of
@@ -391,14 +421,22 @@ void MatrixFreeRssMobility::ForEachTargetsNearSegments(const Matrix3X& targets,
 }
 
 void MatrixFreeRssMobility::FindNearBlocks(const Matrix3X& targets, NearBlocks* out) const {
+  NearBlocksOf(targets, true, out, nullptr);  // other points: the fast sums add every rule
+}
+
+void MatrixFreeRssMobility::NearBlocksOf(const Matrix3X& targets, bool subtract_rule,
+                                         NearBlocks* out,
+                                         std::vector<std::vector<int>>* segments) const {
   std::vector<RssRowKernel> kernels;
   for (int r = 0; r < num_rods(); ++r)
-    kernels.push_back(RowKernel(r, *rods_[static_cast<size_t>(r)].x));
+    kernels.push_back(RowKernel(r, *rods_[static_cast<size_t>(r)].x, subtract_rule));
   per_target_.resize(static_cast<size_t>(targets.cols()));
+  if (segments) segments->resize(static_cast<size_t>(targets.cols()));
   ForEachTargetsNearSegments(targets, [&](int t, const std::vector<int>& near,
                                           NearRowScratch* scratch) {
     NearPairBlocks(targets.col(t), near, kernels, inverse_voronoi_, scratch,
                    &per_target_[static_cast<size_t>(t)]);
+    if (segments) (*segments)[static_cast<size_t>(t)] = near;
   });
   PackNearBlocks(per_target_, single_far_, out);
 }
@@ -447,7 +485,7 @@ void MatrixFreeRssMobility::NearBlocksAt(
     Matrix3X& x = rod_nodes[static_cast<size_t>(r)];
     x = at.middleCols(first, count);
     inverse_voronoi.segment(first, count) = VoronoiLengths(x).cwiseInverse();
-    kernels.push_back(RowKernel(r, x));
+    kernels.push_back(RowKernel(r, x, !exclude_near_));
   }
   blocks->resize(static_cast<size_t>(at.cols()));
   const int n = static_cast<int>(which.size());
@@ -500,7 +538,8 @@ void MatrixFreeRssMobility::RemapNearHistory(const NearBlocks& pattern) {
 }
 
 void MatrixFreeRssMobility::UpdateNearBlocks() {
-  if (!reuse_near_) return FindNearBlocks(nodes_, &near_);
+  near_lists_in_reuse_ = reuse_near_;
+  if (!reuse_near_) return NearBlocksOf(nodes_, !exclude_near_, &near_, &own_near_segments_);
   NearBlocks pattern;
   FindNearPattern(&pattern);
   // (the node pattern follows from the segments: comparing those suffices)
@@ -540,7 +579,7 @@ void MatrixFreeRssMobility::NearPairBlocks(const Vec3& p, const std::vector<int>
                                            const std::vector<RssRowKernel>& kernels,
                                            const VecX& inverse_voronoi, NearRowScratch* scratch,
                                            std::vector<std::pair<int, Mat3>>* blocks) const {
-  // The exact near pairs minus the far sum's rule, by rows of RssRowKernel over the range of a
+  // The exact near pairs (minus the far sum's rule, if the kernels subtract it), by rows of RssRowKernel over the range of a
   // rod's segments that are near p (vectorized; columns of segments in the range that are not
   // near are left out), to the far field's accuracy.
   const double scale = 1.0 / (8.0 * kPi * params_.viscosity);
@@ -560,7 +599,7 @@ void MatrixFreeRssMobility::NearPairBlocks(const Vec3& p, const std::vector<int>
       is_near[static_cast<size_t>(near[k] - rod_first_segment - lo)] = 1;
     const RssRowKernel& kernel = kernels[static_cast<size_t>(rod)];
     kernel.Row(p, lo, count, table.data());
-    kernel.SubtractRule(p, lo, count, table.data());
+    if (kernel.subtracts_rule()) kernel.SubtractRule(p, lo, count, table.data());
     // Node k (local) collects A_a of segment k and A_b of segment k − 1, near ones only.
     for (int k = lo; k <= hi + 1; ++k) {
       const bool a_near = k <= hi && is_near[static_cast<size_t>(k - lo)];

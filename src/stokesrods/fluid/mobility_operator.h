@@ -104,6 +104,11 @@ struct MobilityOptions {
   /// same tolerance at that distance (fluid/far_rule_sum.h); false: the split's points on every
   /// rod (tests, the reference) [–].
   bool far_rule_by_distance = true;
+  /// Matrix-free, where the far rule by distance serves: the nodes' near pairs are left out of
+  /// the far sum and their near corrections are the closed forms alone, instead of the sum adding
+  /// the rule there and the corrections taking it back (fluid/far_rule_sum.h); false: the latter
+  /// (tests, the reference) [–].
+  bool exclude_near_from_far_sum = true;
   /// Dense: 𝕄 reused across Updates (time steps) by extrapolation while its measured relative
   /// error stays below this (fluid/mobility_reuse.h); 0 assembles at every Update. From
   /// kSinglePrecisionTolerance on, the products take 𝕄 in single precision also where it was
