@@ -395,7 +395,8 @@ TEST(StokesletSumTest, SingleKernelOverAnyRangeMatchesThePlainSum) {
 // The sums at several targets at once (one read of each block of sources for all of them)
 // against the one-target sums, for 1 … kPointSumTargets targets, in double, in float and over
 // ranges of whole blocks: bit for bit, since each target's arithmetic and order are the same;
-// and over ranges of any length together (AddPointSumRangesTargets).
+// and over ranges of any length together (AddPointSumRangesTargets), in float also flushed after
+// every range (bit for bit the ranges one by one).
 TEST(StokesletSumTest, SeveralTargetsAtOnceEqualEachTargetAlone) {
   std::mt19937 rng(8);
   std::uniform_real_distribution<double> unit(-0.1, 0.1);
@@ -451,6 +452,20 @@ TEST(StokesletSumTest, SeveralTargetsAtOnceEqualEachTargetAlone) {
               1e-13 * by_range.leftCols(n).cwiseAbs().maxCoeff());
     EXPECT_LT((ranged.rightCols(n) - by_range.rightCols(n)).cwiseAbs().maxCoeff(),
               1e-6 * by_range.rightCols(n).cwiseAbs().maxCoeff());
+    // Each range's lanes added to the ranges' sum after it: n targets bit for bit each alone,
+    // and the ranges one by one to the rounding.
+    Matrix3X flushed = Matrix3X::Zero(3, 2 * n);
+    double* flushed_out[kPointSumTargets];
+    for (int k = 0; k < n; ++k) {
+      flushed_out[k] = flushed.col(k).data();
+      double* one[1] = {flushed.col(n + k).data()};
+      AddPointSumRangesTargets(ColumnsF(src_f), odd.data(), 3, 1, &xs[k], one, true);
+    }
+    AddPointSumRangesTargets(ColumnsF(src_f), odd.data(), 3, n, xs, flushed_out, true);
+    for (Eigen::Index k = 0; k < 3 * n; ++k)
+      EXPECT_EQ(flushed.data()[k], flushed.data()[3 * n + k]) << n << " targets, flushed";
+    EXPECT_LT((flushed.leftCols(n) - by_range.rightCols(n)).cwiseAbs().maxCoeff(),
+              1e-6 * by_range.rightCols(n).cwiseAbs().maxCoeff());
   }
 }
 
@@ -460,9 +475,9 @@ TEST(StokesletSumTest, SeveralTargetsAtOnceEqualEachTargetAlone) {
 // float within its rounding (1e-6); and n targets at once bit for bit each target alone.
 TEST(StokesletSumTest, EachInstructionSetsSumsMatchTheKernel) {
   using Sum = void (*)(const SourceColumns&, const SourceRange*, int, int, const double* const*,
-                       double* const*);
+                       double* const*, bool);
   using SumF = void (*)(const SourceColumnsF&, const SourceRange*, int, int, const float* const*,
-                        double* const*);
+                        double* const*, bool);
   struct Isa {
     const char* name;
     bool present;
@@ -497,8 +512,8 @@ TEST(StokesletSumTest, EachInstructionSetsSumsMatchTheKernel) {
         out[0][k] = together.col(k).data(), out[1][k] = together.col(kPointSumTargets + k).data();
         double* one_d[1] = {alone.col(k).data()};
         double* one_f[1] = {alone.col(kPointSumTargets + k).data()};
-        isa.sum(Columns(src), &range, 1, 1, &xd[k], one_d);
-        isa.sum_f(ColumnsF(src_f), &range, 1, 1, &xs[k], one_f);
+        isa.sum(Columns(src), &range, 1, 1, &xd[k], one_d, false);
+        isa.sum_f(ColumnsF(src_f), &range, 1, 1, &xs[k], one_f, false);
         Vec3 ref = Vec3::Zero(), ref_f = Vec3::Zero();
         const Vec3 x_f = xf.col(k).cast<double>();
         for (int s = range.begin; s < range.end; ++s) {
@@ -519,8 +534,8 @@ TEST(StokesletSumTest, EachInstructionSetsSumsMatchTheKernel) {
       }
       for (int n = 1; n <= kPointSumTargets; ++n) {
         together.setZero();
-        isa.sum(Columns(src), &range, 1, n, xd, out[0]);
-        isa.sum_f(ColumnsF(src_f), &range, 1, n, xs, out[1]);
+        isa.sum(Columns(src), &range, 1, n, xd, out[0], false);
+        isa.sum_f(ColumnsF(src_f), &range, 1, n, xs, out[1], false);
         for (int k = 0; k < n; ++k)
           for (int c = 0; c < 3; ++c) {
             EXPECT_EQ(together(c, k), alone(c, k)) << isa.name << " " << n << " targets";

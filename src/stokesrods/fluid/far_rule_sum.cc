@@ -240,7 +240,7 @@ void FarRuleSum::Apply(const Matrix3X& density, Matrix3X* w) const {
       const auto sum = [&](const SourceRange* ranges, int count, int targets, int k) {
         if (count == 0) return;
         if (single_)
-          AddPointSumRangesTargets(columns_f, ranges, count, targets, xf + k, out + k);
+          AddPointSumRangesTargets(columns_f, ranges, count, targets, xf + k, out + k, true);
         else
           AddPointSumRangesTargets(columns, ranges, count, targets, x + k, out + k);
       };

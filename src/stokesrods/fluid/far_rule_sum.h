@@ -21,7 +21,10 @@
 // the step-to-step noise of the operator that the drag's extrapolation amplifies into GMRES's
 // right-hand side (docs/performance.md, sessions 26, 29 and 30). The targets are summed K at a
 // time over shared ranges of sources (point_stokeslet.h); the union of the K targets' left-out
-// points is cut from those ranges and summed for each target alone, without its own.
+// points is cut from those ranges and summed for each target alone, without its own. In single
+// precision each range is summed in lanes of its own and added to the ranges' lanes after it
+// (AddPointSumRangesTargets' flush_ranges): the accumulation's rounding, the next largest part of
+// that noise, falls with it (ring10: GMRES products per step 2.7 → 2.45).
 // Used where the far sum is direct (the FMM sums one set of points, and its tree replaces the
 // distant pairs anyway).
 #pragma once

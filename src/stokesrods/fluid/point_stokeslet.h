@@ -40,11 +40,14 @@ void AddPointSumBlocks(const SourceColumnsF& c, const SourceRange* ranges, int c
 /// each block of sources is read once for all n (one target alone reads 7 vectors per block, and
 /// its loop ran at less than half the rate of the multiply–add pipes on an Intel Xeon), and the
 /// lanes are reduced once per target for all ranges. Each target's sum is bit for bit the
-/// one-target sum.
+/// one-target sum. In single precision, flush_ranges sums each range in lanes of its own and adds
+/// them to the ranges' lanes after it (each term then rounds against its range's partial sum, not
+/// the whole sum's; three additions more per range and target): the far rule sum's ranges
+/// (far_rule_sum.h).
 void AddPointSumRangesTargets(const SourceColumns& c, const SourceRange* ranges, int count, int n,
                               const double* const* x, double* const* w);
 void AddPointSumRangesTargets(const SourceColumnsF& c, const SourceRange* ranges, int count, int n,
-                              const float* const* x, double* const* w);
+                              const float* const* x, double* const* w, bool flush_ranges = false);
 /// The same over ranges of whole blocks (AddPointSumBlocks' layout: its portable loop without
 /// AVX2).
 void AddPointSumBlocksTargets(const SourceColumnsF& c, const SourceRange* ranges, int count,

@@ -11,13 +11,13 @@
 namespace stokesrods {
 
 void PointSumTargetsAvx2(const SourceColumns& c, const SourceRange* ranges, int count, int n,
-                         const double* const* x, double* const* w) {
-  PointSumTargets<Avx2<double>, kPointSumTargets>(c, ranges, count, n, x, w);
+                         const double* const* x, double* const* w, bool flush_ranges) {
+  PointSumTargets<Avx2<double>, kPointSumTargets>(c, ranges, count, n, x, w, flush_ranges);
 }
 
 void PointSumTargetsAvx2(const SourceColumnsF& c, const SourceRange* ranges, int count, int n,
-                         const float* const* x, double* const* w) {
-  PointSumTargets<Avx2<float>, kPointSumTargets>(c, ranges, count, n, x, w);
+                         const float* const* x, double* const* w, bool flush_ranges) {
+  PointSumTargets<Avx2<float>, kPointSumTargets>(c, ranges, count, n, x, w, flush_ranges);
 }
 
 }  // namespace stokesrods

@@ -29,15 +29,16 @@ inline constexpr int kPointSumTargets = 4;
 
 /// w[k] += Σ over the ranges of S_ε_s(x[k] − y_s) g_s for n ≤ kPointSumTargets targets, each
 /// block of sources read once for all n; each target's sum bit for bit its sum alone (n = 1).
+/// flush_ranges: each range summed in lanes of its own, then added to the ranges' lanes.
 /// Call only where the CPU has the instruction set (HasPointSumAvx512, HasPointSumAvx2).
 void PointSumTargetsAvx512(const SourceColumns& c, const SourceRange* ranges, int count, int n,
-                           const double* const* x, double* const* w);
+                           const double* const* x, double* const* w, bool flush_ranges);
 void PointSumTargetsAvx512(const SourceColumnsF& c, const SourceRange* ranges, int count, int n,
-                           const float* const* x, double* const* w);
+                           const float* const* x, double* const* w, bool flush_ranges);
 void PointSumTargetsAvx2(const SourceColumns& c, const SourceRange* ranges, int count, int n,
-                         const double* const* x, double* const* w);
+                         const double* const* x, double* const* w, bool flush_ranges);
 void PointSumTargetsAvx2(const SourceColumnsF& c, const SourceRange* ranges, int count, int n,
-                         const float* const* x, double* const* w);
+                         const float* const* x, double* const* w, bool flush_ranges);
 
 /// Whether the CPU has AVX-512 F; AVX2 and FMA (x86-64 builds; false elsewhere).
 bool HasPointSumAvx512();

@@ -51,6 +51,7 @@ struct Avx512<float> {
   static V Load(Mask m, const float* p) { return _mm512_maskz_loadu_ps(m, p); }
   static V LoadOr(V fill, Mask m, const float* p) { return _mm512_mask_loadu_ps(fill, m, p); }
   static V Sub(V a, V b) { return _mm512_sub_ps(a, b); }
+  static V Add(V a, V b) { return _mm512_add_ps(a, b); }
   static V Mul(V a, V b) { return _mm512_mul_ps(a, b); }
   static V Fma(V a, V b, V c) { return _mm512_fmadd_ps(a, b, c); }
   static V InverseSqrt(V a) {
@@ -72,6 +73,7 @@ struct Avx512<double> {
   static V Load(Mask m, const double* p) { return _mm512_maskz_loadu_pd(m, p); }
   static V LoadOr(V fill, Mask m, const double* p) { return _mm512_mask_loadu_pd(fill, m, p); }
   static V Sub(V a, V b) { return _mm512_sub_pd(a, b); }
+  static V Add(V a, V b) { return _mm512_add_pd(a, b); }
   static V Mul(V a, V b) { return _mm512_mul_pd(a, b); }
   static V Fma(V a, V b, V c) { return _mm512_fmadd_pd(a, b, c); }
   static V InverseSqrt(V a) {
@@ -114,6 +116,7 @@ struct Avx2<float> {
                                       _mm256_castsi256_ps(m.lanes));
   }
   static V Sub(V a, V b) { return _mm256_sub_ps(a, b); }
+  static V Add(V a, V b) { return _mm256_add_ps(a, b); }
   static V Mul(V a, V b) { return _mm256_mul_ps(a, b); }
   static V Fma(V a, V b, V c) { return _mm256_fmadd_ps(a, b, c); }
   static V InverseSqrt(V a) {
@@ -147,6 +150,7 @@ struct Avx2<double> {
                                       _mm256_castsi256_pd(m.lanes));
   }
   static V Sub(V a, V b) { return _mm256_sub_pd(a, b); }
+  static V Add(V a, V b) { return _mm256_add_pd(a, b); }
   static V Mul(V a, V b) { return _mm256_mul_pd(a, b); }
   static V Fma(V a, V b, V c) { return _mm256_fmadd_pd(a, b, c); }
   static V InverseSqrt(V a) { return _mm256_div_pd(Set(1.0), _mm256_sqrt_pd(a)); }
@@ -157,17 +161,21 @@ struct Avx2<double> {
 };
 #endif  // __AVX2__ && __FMA__
 
-// w[k] += the sum over the ranges at x[k], k < K, on the vectors of A.
+// w[k] += the sum over the ranges at x[k], k < K, on the vectors of A. With flush_ranges each
+// range is summed in lanes of its own, added to the ranges' lanes after it (so that no lane
+// accumulates the whole sum's terms one by one: fewer roundings against the large partial sums).
 template <class A, int K, class T, class Columns>
 void PointSumRanges(const Columns& c, const SourceRange* ranges, int count, const T* const* x,
-                    double* const* w) {
+                    double* const* w, bool flush_ranges) {
   using V = typename A::V;
   const V one = A::Set(T(1));
   V px[K], py[K], pz[K], wx[K], wy[K], wz[K];
+  V vx[K], vy[K], vz[K];  // the ranges' sums, if flushed
 #pragma GCC unroll 8
   for (int k = 0; k < K; ++k) {
     px[k] = A::Set(x[k][0]), py[k] = A::Set(x[k][1]), pz[k] = A::Set(x[k][2]);
     wx[k] = A::Set(T(0)), wy[k] = wx[k], wz[k] = wx[k];
+    vx[k] = wx[k], vy[k] = wx[k], vz[k] = wx[k];
   }
   for (int r = 0; r < count; ++r) {
     for (int s = ranges[r].begin; s < ranges[r].end; s += A::kLanes) {
@@ -188,9 +196,17 @@ void PointSumRanges(const Columns& c, const SourceRange* ranges, int count, cons
         wz[k] = A::Fma(a, gz, A::Fma(b, rz, wz[k]));
       }
     }
+    if (flush_ranges) {
+#pragma GCC unroll 8
+      for (int k = 0; k < K; ++k) {
+        vx[k] = A::Add(vx[k], wx[k]), vy[k] = A::Add(vy[k], wy[k]), vz[k] = A::Add(vz[k], wz[k]);
+        wx[k] = A::Set(T(0)), wy[k] = wx[k], wz[k] = wx[k];
+      }
+    }
   }
 #pragma GCC unroll 8
   for (int k = 0; k < K; ++k) {
+    if (flush_ranges) wx[k] = vx[k], wy[k] = vy[k], wz[k] = vz[k];
     w[k][0] += A::Sum(wx[k]);
     w[k][1] += A::Sum(wy[k]);
     w[k][2] += A::Sum(wz[k]);
@@ -200,18 +216,18 @@ void PointSumRanges(const Columns& c, const SourceRange* ranges, int count, cons
 // n ≤ kPointSumTargets targets, kMax (≤ kPointSumTargets) at a time.
 template <class A, int kMax, class T, class Columns>
 void PointSumTargets(const Columns& c, const SourceRange* ranges, int count, int n,
-                     const T* const* x, double* const* w) {
+                     const T* const* x, double* const* w, bool flush_ranges) {
   for (int first = 0; first < n; first += kMax) {
     const int left = n - first < kMax ? n - first : kMax;
     const T* const* xk = x + first;
     double* const* wk = w + first;
-    if (left == 1) PointSumRanges<A, 1>(c, ranges, count, xk, wk);
+    if (left == 1) PointSumRanges<A, 1>(c, ranges, count, xk, wk, flush_ranges);
     if constexpr (kMax >= 2)
-      if (left == 2) PointSumRanges<A, 2>(c, ranges, count, xk, wk);
+      if (left == 2) PointSumRanges<A, 2>(c, ranges, count, xk, wk, flush_ranges);
     if constexpr (kMax >= 3)
-      if (left == 3) PointSumRanges<A, 3>(c, ranges, count, xk, wk);
+      if (left == 3) PointSumRanges<A, 3>(c, ranges, count, xk, wk, flush_ranges);
     if constexpr (kMax >= 4)
-      if (left == 4) PointSumRanges<A, 4>(c, ranges, count, xk, wk);
+      if (left == 4) PointSumRanges<A, 4>(c, ranges, count, xk, wk, flush_ranges);
   }
 }
 

@@ -108,14 +108,14 @@ namespace {
 // false where it has neither (the portable loops above then).
 template <class Columns, class T>
 bool AddSimdTargets(const Columns& c, const SourceRange* ranges, int count, int n,
-                    const T* const* x, double* const* w) {
+                    const T* const* x, double* const* w, bool flush_ranges = false) {
 #if defined(__x86_64__)
   if (HasPointSumAvx512()) {
-    PointSumTargetsAvx512(c, ranges, count, n, x, w);
+    PointSumTargetsAvx512(c, ranges, count, n, x, w, flush_ranges);
     return true;
   }
   if (HasPointSumAvx2()) {
-    PointSumTargetsAvx2(c, ranges, count, n, x, w);
+    PointSumTargetsAvx2(c, ranges, count, n, x, w, flush_ranges);
     return true;
   }
 #endif
@@ -146,8 +146,9 @@ void AddPointSumRangesTargets(const SourceColumns& c, const SourceRange* ranges,
 }
 
 void AddPointSumRangesTargets(const SourceColumnsF& c, const SourceRange* ranges, int count, int n,
-                              const float* const* x, double* const* w) {
-  if (AddSimdTargets(c, ranges, count, n, x, w)) return;
+                              const float* const* x, double* const* w, bool flush_ranges) {
+  // (the portable loops sum and reduce range by range: flushed always)
+  if (AddSimdTargets(c, ranges, count, n, x, w, flush_ranges)) return;
   for (int k = 0; k < n; ++k)
     for (int r = 0; r < count; ++r)
       PointSumSinglePortable(c, ranges[r].begin, ranges[r].end, x[k], w[k]);
