@@ -151,6 +151,33 @@ TEST(BandedMatrix, FallsBackToPivotingWhereThePivotsAreNotPositiveOrGrow) {
   }
 }
 
+// One matrix assembled and factorized again and again, as a rod's Newton matrix is at every
+// step: nothing of an earlier factorization (the pivoting's fill rows, the kept copy of A) may
+// leak into the next. Alternating matrices that need pivoting (zero diagonals), that do not
+// (definite), and again, each solves bit for bit as a fresh matrix with the same entries does.
+TEST(BandedMatrix, ReassembledAfterAPivotedFactorizationSolvesAsAFreshMatrix) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const int n = 64, kd = 10;
+  BandedMatrix reused(n, kd);
+  for (const bool pivot : {true, false, true, true, false, false, true}) {
+    BandedMatrix fresh(n, kd);
+    reused.SetZero();
+    for (int i = 0; i < n; ++i)
+      for (int j = std::max(0, i - kd); j <= std::min(n - 1, i + kd); ++j) {
+        const double v = i == j ? (pivot ? 0.0 : 2.0 * kd + 1.0) : u(rng);
+        reused(i, j) = fresh(i, j) = v;
+      }
+    ASSERT_TRUE(reused.Factorize());
+    ASSERT_TRUE(fresh.Factorize());
+    EXPECT_EQ(reused.pivoted(), pivot);
+    VecX x = VecX::LinSpaced(n, 1.0, 2.0), y = x;
+    reused.Solve(&x);
+    fresh.Solve(&y);
+    for (int i = 0; i < n; ++i) EXPECT_EQ(x(i), y(i)) << "pivoting " << pivot << ", entry " << i;
+  }
+}
+
 TEST(BandedMatrix, FixDofMakesAnIdentityRowAndColumn) {
   BandedMatrix a(5, 1);
   for (int i = 0; i < 5; ++i) a(i, i) = 2.0;

@@ -161,16 +161,17 @@ struct Avx2<double> {
 };
 #endif  // __AVX2__ && __FMA__
 
-// w[k] += the sum over the ranges at x[k], k < K, on the vectors of A. With flush_ranges each
-// range is summed in lanes of its own, added to the ranges' lanes after it (so that no lane
-// accumulates the whole sum's terms one by one: fewer roundings against the large partial sums).
-template <class A, int K, class T, class Columns>
+// w[k] += the sum over the ranges at x[k], k < K, on the vectors of A. With kFlush each range is
+// summed in lanes of its own, added to the ranges' lanes after it (so that no lane accumulates
+// the whole sum's terms one by one: fewer roundings against the large partial sums); a template
+// parameter, so that the other sums keep their registers.
+template <class A, int K, bool kFlush, class T, class Columns>
 void PointSumRanges(const Columns& c, const SourceRange* ranges, int count, const T* const* x,
-                    double* const* w, bool flush_ranges) {
+                    double* const* w) {
   using V = typename A::V;
   const V one = A::Set(T(1));
   V px[K], py[K], pz[K], wx[K], wy[K], wz[K];
-  V vx[K], vy[K], vz[K];  // the ranges' sums, if flushed
+  [[maybe_unused]] V vx[K], vy[K], vz[K];  // the ranges' sums (kFlush)
 #pragma GCC unroll 8
   for (int k = 0; k < K; ++k) {
     px[k] = A::Set(x[k][0]), py[k] = A::Set(x[k][1]), pz[k] = A::Set(x[k][2]);
@@ -196,7 +197,7 @@ void PointSumRanges(const Columns& c, const SourceRange* ranges, int count, cons
         wz[k] = A::Fma(a, gz, A::Fma(b, rz, wz[k]));
       }
     }
-    if (flush_ranges) {
+    if constexpr (kFlush) {
 #pragma GCC unroll 8
       for (int k = 0; k < K; ++k) {
         vx[k] = A::Add(vx[k], wx[k]), vy[k] = A::Add(vy[k], wy[k]), vz[k] = A::Add(vz[k], wz[k]);
@@ -206,7 +207,7 @@ void PointSumRanges(const Columns& c, const SourceRange* ranges, int count, cons
   }
 #pragma GCC unroll 8
   for (int k = 0; k < K; ++k) {
-    if (flush_ranges) wx[k] = vx[k], wy[k] = vy[k], wz[k] = vz[k];
+    if constexpr (kFlush) wx[k] = vx[k], wy[k] = vy[k], wz[k] = vz[k];
     w[k][0] += A::Sum(wx[k]);
     w[k][1] += A::Sum(wy[k]);
     w[k][2] += A::Sum(wz[k]);
@@ -214,21 +215,30 @@ void PointSumRanges(const Columns& c, const SourceRange* ranges, int count, cons
 }
 
 // n ≤ kPointSumTargets targets, kMax (≤ kPointSumTargets) at a time.
-template <class A, int kMax, class T, class Columns>
-void PointSumTargets(const Columns& c, const SourceRange* ranges, int count, int n,
-                     const T* const* x, double* const* w, bool flush_ranges) {
+template <class A, int kMax, bool kFlush, class T, class Columns>
+void PointSumTargetsOf(const Columns& c, const SourceRange* ranges, int count, int n,
+                       const T* const* x, double* const* w) {
   for (int first = 0; first < n; first += kMax) {
     const int left = n - first < kMax ? n - first : kMax;
     const T* const* xk = x + first;
     double* const* wk = w + first;
-    if (left == 1) PointSumRanges<A, 1>(c, ranges, count, xk, wk, flush_ranges);
+    if (left == 1) PointSumRanges<A, 1, kFlush>(c, ranges, count, xk, wk);
     if constexpr (kMax >= 2)
-      if (left == 2) PointSumRanges<A, 2>(c, ranges, count, xk, wk, flush_ranges);
+      if (left == 2) PointSumRanges<A, 2, kFlush>(c, ranges, count, xk, wk);
     if constexpr (kMax >= 3)
-      if (left == 3) PointSumRanges<A, 3>(c, ranges, count, xk, wk, flush_ranges);
+      if (left == 3) PointSumRanges<A, 3, kFlush>(c, ranges, count, xk, wk);
     if constexpr (kMax >= 4)
-      if (left == 4) PointSumRanges<A, 4>(c, ranges, count, xk, wk, flush_ranges);
+      if (left == 4) PointSumRanges<A, 4, kFlush>(c, ranges, count, xk, wk);
   }
+}
+
+template <class A, int kMax, class T, class Columns>
+void PointSumTargets(const Columns& c, const SourceRange* ranges, int count, int n,
+                     const T* const* x, double* const* w, bool flush_ranges) {
+  if (flush_ranges)
+    PointSumTargetsOf<A, kMax, true>(c, ranges, count, n, x, w);
+  else
+    PointSumTargetsOf<A, kMax, false>(c, ranges, count, n, x, w);
 }
 
 }  // namespace
