@@ -133,6 +133,8 @@ class MobilityReuse {
   void Remap(const std::vector<int>& old_column, const AssembleColumns& assemble);
   /// Drops the history: the next Update assembles.
   void Forget();
+  /// The tolerance from now on (the next assembly measures against it and sets the interval).
+  void set_tolerance(double tolerance) { tolerance_ = tolerance; }
   /// The history as a checkpoint keeps it.
   MobilityReuseHistory history() const;
   /// Takes a history kept by history(): the next Update assembles 𝕄 at its geometries first, then
