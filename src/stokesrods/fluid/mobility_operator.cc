@@ -222,12 +222,12 @@ class MatrixFreeRssMobility final : public MobilityOperator {
   // The near blocks of the targets `which` (nodes) with the near segments `segments` (per
   // node), all at the node positions `at` (3 × M): the blocks near_reuse_'s history holds for
   // a geometry of its own (REMAP in fluid/mobility_reuse.h), or at the nodes.
-  // The far rule is subtracted where the far sum adds it (!exclude_near_), or where
-  // `subtract_rule` asks for it.
+  // The far rule is subtracted where the far sum adds it (!exclude_near_); where it does not,
+  // `difference_norm2` (if given) gets per target Σ ‖A − A^Gauss‖_F² of its blocks.
   void NearBlocksAt(const Matrix3X& at, const std::vector<int>& which,
                     const std::vector<std::vector<int>>& segments,
                     std::vector<std::vector<std::pair<int, Mat3>>>* blocks,
-                    bool subtract_rule = false) const;
+                    std::vector<double>* difference_norm2 = nullptr) const;
   // The near pattern changed to `pattern` (segments in pattern_segments_): near_reuse_ keeps
   // the blocks of the targets whose near segments are those of near_segments_, and assembles
   // the others' at its held geometries.
@@ -243,14 +243,13 @@ class MatrixFreeRssMobility final : public MobilityOperator {
   void ChooseSplitByCost();
   // The near blocks at p (node, block) of its near segments (NearSegmentSearch::SegmentsNear).
   struct NearRowScratch {
-    std::vector<double> table;
+    std::vector<double> table, difference;
     std::vector<char> is_near;
   };
-  // Rod r's rows of exact closed forms, minus the far rule where `subtract_rule` (the far sum
-  // adds it at the pair), at its nodes x (kept by reference).
-  RssRowKernel RowKernel(int r, const Matrix3X& x, bool subtract_rule) const {
+  // Rod r's rows of exact closed forms and of the far rule, at its nodes x (kept by reference).
+  RssRowKernel RowKernel(int r, const Matrix3X& x) const {
     return RssRowKernel(x, params_.regularization * rods_[static_cast<size_t>(r)].radius,
-                        accuracy_, subtract_rule ? split_.gauss_points : 0);
+                        accuracy_, split_.gauss_points);
   }
   // The near blocks at `targets` (each with its near segments into `segments`, if given).
   void NearBlocksOf(const Matrix3X& targets, bool subtract_rule, NearBlocks* blocks,
@@ -258,10 +257,14 @@ class MatrixFreeRssMobility final : public MobilityOperator {
   // The far sum by FarRuleSum, its near pairs left out where exclude_near_ (the near segments of
   // the last near blocks at the nodes).
   void BuildRuleSum();
-  // (kernels and inverse_voronoi (1/Λ_j) of one geometry, the one p is taken from)
+  // (kernels and inverse_voronoi (1/Λ_j) of one geometry, the one p is taken from): the closed
+  // forms A, minus the far rule where `subtract_rule`; else, if `difference_norm2` is given,
+  // Σ ‖A − A^Gauss‖_F² of the blocks into it (the same rows: the closed forms once).
   void NearPairBlocks(const Vec3& p, const std::vector<int>& near,
                       const std::vector<RssRowKernel>& kernels, const VecX& inverse_voronoi,
-                      NearRowScratch* scratch, std::vector<std::pair<int, Mat3>>* blocks) const;
+                      bool subtract_rule, NearRowScratch* scratch,
+                      std::vector<std::pair<int, Mat3>>* blocks,
+                      double* difference_norm2 = nullptr) const;
   // Per segment its first node and ε; per rod its first segment (and the total last).
   void SegmentLists(std::vector<int>* first_node, VecX* eps,
                     std::vector<int>* rod_first_segment) const;
@@ -434,12 +437,12 @@ void MatrixFreeRssMobility::NearBlocksOf(const Matrix3X& targets, bool subtract_
                                          std::vector<std::vector<int>>* segments) const {
   std::vector<RssRowKernel> kernels;
   for (int r = 0; r < num_rods(); ++r)
-    kernels.push_back(RowKernel(r, *rods_[static_cast<size_t>(r)].x, subtract_rule));
+    kernels.push_back(RowKernel(r, *rods_[static_cast<size_t>(r)].x));
   per_target_.resize(static_cast<size_t>(targets.cols()));
   if (segments) segments->resize(static_cast<size_t>(targets.cols()));
   ForEachTargetsNearSegments(targets, [&](int t, const std::vector<int>& near,
                                           NearRowScratch* scratch) {
-    NearPairBlocks(targets.col(t), near, kernels, inverse_voronoi_, scratch,
+    NearPairBlocks(targets.col(t), near, kernels, inverse_voronoi_, subtract_rule, scratch,
                    &per_target_[static_cast<size_t>(t)]);
     if (segments) (*segments)[static_cast<size_t>(t)] = near;
   });
@@ -480,7 +483,8 @@ void MatrixFreeRssMobility::FindNearPattern(NearBlocks* pattern) const {
 void MatrixFreeRssMobility::NearBlocksAt(
     const Matrix3X& at, const std::vector<int>& which,
     const std::vector<std::vector<int>>& segments,
-    std::vector<std::vector<std::pair<int, Mat3>>>* blocks, bool subtract_rule) const {
+    std::vector<std::vector<std::pair<int, Mat3>>>* blocks,
+    std::vector<double>* difference_norm2) const {
   // The rods' nodes, kernels and 1/Λ_j at `at` (the kernels keep their nodes by reference).
   std::vector<Matrix3X> rod_nodes(static_cast<size_t>(num_rods()));
   std::vector<RssRowKernel> kernels;
@@ -490,9 +494,10 @@ void MatrixFreeRssMobility::NearBlocksAt(
     Matrix3X& x = rod_nodes[static_cast<size_t>(r)];
     x = at.middleCols(first, count);
     inverse_voronoi.segment(first, count) = VoronoiLengths(x).cwiseInverse();
-    kernels.push_back(RowKernel(r, x, subtract_rule || !exclude_near_));
+    kernels.push_back(RowKernel(r, x));
   }
   blocks->resize(static_cast<size_t>(at.cols()));
+  if (difference_norm2) difference_norm2->assign(static_cast<size_t>(at.cols()), 0.0);
   const int n = static_cast<int>(which.size());
 #pragma omp parallel
   {
@@ -501,7 +506,8 @@ void MatrixFreeRssMobility::NearBlocksAt(
     for (int i = 0; i < n; ++i) {
       const int t = which[static_cast<size_t>(i)];
       NearPairBlocks(at.col(t), segments[static_cast<size_t>(t)], kernels, inverse_voronoi,
-                     &scratch, &(*blocks)[static_cast<size_t>(t)]);
+                     !exclude_near_, &scratch, &(*blocks)[static_cast<size_t>(t)],
+                     difference_norm2 ? &(*difference_norm2)[static_cast<size_t>(t)] : nullptr);
     }
   }
 }
@@ -560,7 +566,8 @@ void MatrixFreeRssMobility::UpdateNearBlocks() {
     // (reuse_near_ only there).
     std::vector<int> all(static_cast<size_t>(nodes_.cols()));
     std::iota(all.begin(), all.end(), 0);
-    NearBlocksAt(nodes_, all, near_segments_, &per_target_);
+    std::vector<double> difference2;
+    NearBlocksAt(nodes_, all, near_segments_, &per_target_, exclude_near_ ? &difference2 : nullptr);
     PackNearBlocks(per_target_, single_far_, &near_);
     SR_ASSERT(near_.source == pattern.source, "the near pattern changed within an Update");
     if (exclude_near_) {
@@ -569,16 +576,12 @@ void MatrixFreeRssMobility::UpdateNearBlocks() {
       // scaled by ‖A − A^Gauss‖_F / ‖A‖_F here, so that the error allowed is the same in
       // absolute terms (measured on ten helices over 2 s: without the scaling the clamp forces
       // strayed 14 times farther from the accurate run's than with the rule subtracted).
-      std::vector<std::vector<std::pair<int, Mat3>>> subtracted;
-      NearBlocksAt(nodes_, all, near_segments_, &subtracted, true);
-      double exact2 = 0.0, difference2 = 0.0;
-      for (std::size_t t = 0; t < per_target_.size(); ++t)
-        for (std::size_t k = 0; k < per_target_[t].size(); ++k) {
-          exact2 += per_target_[t][k].second.squaredNorm();
-          difference2 += subtracted[t][k].second.squaredNorm();
-        }
+      double exact2 = 0.0, difference = 0.0;
+      for (const auto& list : per_target_)
+        for (const auto& [node, block] : list) exact2 += block.squaredNorm();
+      for (const double d : difference2) difference += d;
       near_reuse_.set_tolerance(near_reuse_tolerance_ *
-                                (exact2 > 0.0 ? std::sqrt(difference2 / exact2) : 1.0));
+                                (exact2 > 0.0 ? std::sqrt(difference / exact2) : 1.0));
     }
     *values = Eigen::Map<const Eigen::MatrixXf>(near_.block_single.front().data(), 9, count)
                   .cast<double>();
@@ -599,11 +602,13 @@ void MatrixFreeRssMobility::UpdateNearBlocks() {
 
 void MatrixFreeRssMobility::NearPairBlocks(const Vec3& p, const std::vector<int>& near,
                                            const std::vector<RssRowKernel>& kernels,
-                                           const VecX& inverse_voronoi, NearRowScratch* scratch,
-                                           std::vector<std::pair<int, Mat3>>* blocks) const {
-  // The exact near pairs (minus the far sum's rule, if the kernels subtract it), by rows of RssRowKernel over the range of a
-  // rod's segments that are near p (vectorized; columns of segments in the range that are not
-  // near are left out), to the far field's accuracy.
+                                           const VecX& inverse_voronoi, bool subtract_rule,
+                                           NearRowScratch* scratch,
+                                           std::vector<std::pair<int, Mat3>>* blocks,
+                                           double* difference_norm2) const {
+  // The exact near pairs (minus the far sum's rule where asked), by rows of RssRowKernel over the
+  // range of a rod's segments that are near p (vectorized; columns of segments in the range that
+  // are not near are left out), to the far field's accuracy.
   const double scale = 1.0 / (8.0 * kPi * params_.viscosity);
   std::vector<double>& table = scratch->table;
   std::vector<char>& is_near = scratch->is_near;
@@ -621,20 +626,30 @@ void MatrixFreeRssMobility::NearPairBlocks(const Vec3& p, const std::vector<int>
       is_near[static_cast<size_t>(near[k] - rod_first_segment - lo)] = 1;
     const RssRowKernel& kernel = kernels[static_cast<size_t>(rod)];
     kernel.Row(p, lo, count, table.data());
-    if (kernel.subtracts_rule()) kernel.SubtractRule(p, lo, count, table.data());
+    const bool difference = !subtract_rule && difference_norm2;
+    if (subtract_rule) kernel.SubtractRule(p, lo, count, table.data());
+    if (difference) {
+      scratch->difference = table;
+      kernel.SubtractRule(p, lo, count, scratch->difference.data());
+    }
     // Node k (local) collects A_a of segment k and A_b of segment k − 1, near ones only.
+    const auto block_at = [&](const std::vector<double>& rows, int k, bool a_near, bool b_near) {
+      double e[6];
+      for (int c = 0; c < 6; ++c)
+        e[c] = (a_near ? rows[static_cast<size_t>(c * count + k - lo)] : 0.0) +
+               (b_near ? rows[static_cast<size_t>((6 + c) * count + k - 1 - lo)] : 0.0);
+      const int node = node_offset(rod) + k;
+      Mat3 block;
+      block << e[0], e[1], e[2], e[1], e[3], e[4], e[2], e[4], e[5];
+      return Mat3((scale * inverse_voronoi(node)) * block);
+    };
     for (int k = lo; k <= hi + 1; ++k) {
       const bool a_near = k <= hi && is_near[static_cast<size_t>(k - lo)];
       const bool b_near = k > lo && is_near[static_cast<size_t>(k - 1 - lo)];
       if (!a_near && !b_near) continue;
-      double e[6];
-      for (int c = 0; c < 6; ++c)
-        e[c] = (a_near ? table[static_cast<size_t>(c * count + k - lo)] : 0.0) +
-               (b_near ? table[static_cast<size_t>((6 + c) * count + k - 1 - lo)] : 0.0);
-      const int node = node_offset(rod) + k;
-      Mat3 block;
-      block << e[0], e[1], e[2], e[1], e[3], e[4], e[2], e[4], e[5];
-      blocks->emplace_back(node, (scale * inverse_voronoi(node)) * block);
+      blocks->emplace_back(node_offset(rod) + k, block_at(table, k, a_near, b_near));
+      if (difference)
+        *difference_norm2 += block_at(scratch->difference, k, a_near, b_near).squaredNorm();
     }
     i = end;
   }

@@ -26,8 +26,6 @@ class RssRowKernel {
                int subtracted_rule = 0);
 
   int segments() const { return segments_; }
-  /// Whether SubtractRule has a rule to remove (g > 0).
-  bool subtracts_rule() const { return subtracted_.points > 0; }
 
   /// table (12 rows, stride `count`) = A_a, A_b of segments [first, first + count) at p.
   void Row(const Vec3& p, int first, int count, double* table) const;
