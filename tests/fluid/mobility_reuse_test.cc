@@ -4,6 +4,9 @@
 #include "stokesrods/fluid/mobility_reuse.h"
 
 #include <gtest/gtest.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include <cmath>
 #include <cstdio>
@@ -317,10 +320,12 @@ float DecodeHalf(std::uint16_t h) {
 void CheckRoundsToWhatTheHalfValuesStandFor(bool f16c) {
   std::mt19937 random(7);
   std::uniform_real_distribution<float> decade(-7.0f, 2.0f), unit(-1.0f, 1.0f);
-  for (const int n : {1, 15, 16, 17, 1000}) {
+  // (100 003: in two parts over the threads, the largest entry in the second.)
+  for (const int n : {1, 15, 16, 17, 1000, 100003}) {
     std::vector<float> d(static_cast<std::size_t>(n));
     for (float& v : d) v = unit(random) * std::pow(10.0f, decade(random));
     if (n > 2) d[1] = 0.0f;
+    if (n > 1000) d[static_cast<std::size_t>(n) - 3] = 1e3f;
     const std::vector<float> before = d;
     std::vector<std::uint16_t> half(d.size());
     const float scale = RoundToHalf(n, d.data(), half.data(), f16c);
@@ -346,15 +351,46 @@ void CheckRoundsToWhatTheHalfValuesStandFor(bool f16c) {
   EXPECT_EQ(RoundToHalf(20, zeros.data(), half.data(), f16c), 1.0f);
   EXPECT_EQ(half[19], 0);
   for (const float bad : {NAN, INFINITY}) {
-    for (const int where : {3, 33, 38}) {  // in a whole block of 8 or 16, or in the last entries
-      std::vector<float> d(39, 1.0f);
+    // In a whole block of 8 or 16, or in the last entries; of 70 001, in the second part.
+    for (const auto& [n, where] : {std::pair{39, 3}, {39, 33}, {39, 38}, {70001, 70000}}) {
+      std::vector<float> d(static_cast<std::size_t>(n), 1.0f);
       d[static_cast<std::size_t>(where)] = bad;
-      std::vector<std::uint16_t> untouched(39, 0x1234);
-      EXPECT_EQ(RoundToHalf(39, d.data(), untouched.data(), f16c), 0.0f) << where;
+      std::vector<std::uint16_t> untouched(d.size(), 0x1234);
+      EXPECT_EQ(RoundToHalf(n, d.data(), untouched.data(), f16c), 0.0f) << where;
       EXPECT_EQ(untouched[0], 0x1234);
       EXPECT_EQ(d[0], 1.0f);
     }
   }
+}
+
+// The rounding of a large matrix (two parts over the threads from 2¹⁶ entries) gives the same
+// scale and bits on one thread and on two.
+TEST(MobilityReuseHalf, RoundsToTheSameBitsOnAnyNumberOfThreads) {
+  if (!HasHalfDifferences()) GTEST_SKIP() << "neither AVX-512 BW nor F16C on this CPU";
+#ifdef _OPENMP
+  std::mt19937 random(9);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  const int n = 9 * 20011;
+  std::vector<float> before(static_cast<std::size_t>(n));
+  for (float& v : before) v = unit(random);
+  before[static_cast<std::size_t>(n) - 5] = 7.5f;  // the largest, in the second part
+  std::vector<float> d[2] = {before, before};
+  std::vector<std::uint16_t> half[2] = {std::vector<std::uint16_t>(before.size()),
+                                        std::vector<std::uint16_t>(before.size())};
+  float scale[2];
+  const int saved = omp_get_max_threads();
+  for (int threads = 1; threads <= 2; ++threads) {
+    omp_set_num_threads(threads);
+    scale[threads - 1] = RoundToHalf(n, d[threads - 1].data(), half[threads - 1].data());
+  }
+  omp_set_num_threads(saved);
+  EXPECT_EQ(scale[0], scale[1]);
+  EXPECT_EQ(scale[0], 4096.0f);  // 2^(14 − ⌊log₂ 7.5⌋)
+  EXPECT_TRUE(half[0] == half[1]);
+  EXPECT_TRUE(d[0] == d[1]);
+#else
+  GTEST_SKIP() << "built without OpenMP";
+#endif
 }
 
 TEST(MobilityReuseHalf, RoundsToWhatTheHalfValuesStandFor) {

@@ -323,14 +323,28 @@ FmmTree BuildFmmTree(const Matrix3X& sources, const Matrix3X& targets, double mi
   // The root's side, extent × 2^(k/4), k = 0 … 3: leaves of any width within a factor 2^(1/8)
   // (a uniform tree offers only extent / 2^depth), chosen by the estimated cost. The levels below
   // the estimate's depth are not built (when it counted every level it needed).
+  // The three estimates over the threads, taken in order of k (the same choice on any count).
+  std::array<LeastCostDepth, 4> widened;
+  std::array<double, 4> widths{};
+#pragma omp parallel for schedule(dynamic, 1)
   for (int k = 1; k < 4; ++k) {
-    const double width = extent * (1.0 + 1e-9) * std::exp2(0.25 * k);
-    const LeastCostDepth c = LeastCost(sources, targets, tree.corner, width, min_leaf_width, cost);
-    if (c.complete && c.cost < least.cost) least = c, tree.width = width;
+    widths[static_cast<size_t>(k)] = extent * (1.0 + 1e-9) * std::exp2(0.25 * k);
+    widened[static_cast<size_t>(k)] =
+        LeastCost(sources, targets, tree.corner, widths[static_cast<size_t>(k)], min_leaf_width, cost);
+  }
+  for (int k = 1; k < 4; ++k) {
+    const LeastCostDepth& c = widened[static_cast<size_t>(k)];
+    if (c.complete && c.cost < least.cost) least = c, tree.width = widths[static_cast<size_t>(k)];
   }
   const int max_level = least.complete && least.depth >= 2 ? least.depth : kMaxLevel;
-  const auto src = SortByCode(sources, tree.corner, tree.width, &tree.source_order);
-  const auto tgt = SortByCode(targets, tree.corner, tree.width, &tree.target_order);
+  std::vector<std::uint64_t> src, tgt;
+#pragma omp parallel sections
+  {
+#pragma omp section
+    src = SortByCode(sources, tree.corner, tree.width, &tree.source_order);
+#pragma omp section
+    tgt = SortByCode(targets, tree.corner, tree.width, &tree.target_order);
+  }
   const double points = static_cast<double>(sources.cols() + targets.cols());
   tree.levels.push_back(MakeLevel(0, src, tgt));
   tree.levels.push_back(MakeLevel(1, src, tgt));

@@ -254,12 +254,23 @@ void MobilityReuse::Remap(const std::vector<int>& old_column, const AssembleColu
     }
     return out;
   };
-  base_ = remap(base_, base);
-  if (with_slope)
-    slope_ = remap(slope_, slope);
-  else
-    slope_.resize(rows, cols);  // written by the next Take
-  if (quadratic_) curve_ = remap(curve_, curve);
+  // The matrices over the threads (passes over memory; on a hundred helices 5 MB each).
+#pragma omp parallel sections if (rows * cols >= kParallelEntries)
+  {
+#pragma omp section
+    base_ = remap(base_, base);
+#pragma omp section
+    {
+      if (with_slope)
+        slope_ = remap(slope_, slope);
+      else
+        slope_.resize(rows, cols);  // written by the next Take
+    }
+#pragma omp section
+    {
+      if (quadratic_) curve_ = remap(curve_, curve);
+    }
+  }
   // D₁, D₂ to half precision again, at the scale of the remapped matrices (PRECISION).
   if (half_current_) half_current_ = RoundDifferencesToHalf(quadratic_);
   ++stats_.remaps;

@@ -42,7 +42,8 @@ float HalfScale(float top) {
   return top > 0.0f ? std::ldexp(1.0f, std::min(14 - std::ilogb(top), 126)) : 1.0f;
 }
 
-SR_HALF float RoundToHalfAvx512(Eigen::Index n, float* d, std::uint16_t* half) {
+// The largest |entry| of d in *top; false when an entry is infinite or not a number.
+SR_HALF bool LargestAvx512(Eigen::Index n, const float* d, float* top) {
   __m512 largest = _mm512_setzero_ps();
   __m512 poison = _mm512_setzero_ps();  // not a number once an entry is infinite or not a number
   for (Eigen::Index i = 0; i < n; i += 16) {
@@ -50,8 +51,12 @@ SR_HALF float RoundToHalfAvx512(Eigen::Index n, float* d, std::uint16_t* half) {
     largest = _mm512_max_ps(largest, _mm512_abs_ps(v));
     poison = _mm512_add_ps(poison, _mm512_mul_ps(v, _mm512_setzero_ps()));
   }
-  if (std::isnan(_mm512_reduce_add_ps(poison))) return 0.0f;
-  const float scale = HalfScale(_mm512_reduce_max_ps(largest));
+  *top = _mm512_reduce_max_ps(largest);
+  return !std::isnan(_mm512_reduce_add_ps(poison));
+}
+
+// half = σ d in half precision, d ← half / σ.
+SR_HALF void ToHalfAvx512(Eigen::Index n, float* d, std::uint16_t* half, float scale) {
   const __m512 up = _mm512_set1_ps(scale), down = _mm512_set1_ps(1.0f / scale);
   for (Eigen::Index i = 0; i < n; i += 16) {
     const __mmask16 m = Lanes(n - i);
@@ -60,7 +65,6 @@ SR_HALF float RoundToHalfAvx512(Eigen::Index n, float* d, std::uint16_t* half) {
     _mm256_mask_storeu_epi16(half + i, m, h);
     _mm512_mask_storeu_ps(d + i, m, _mm512_mul_ps(_mm512_cvtph_ps(h), down));
   }
-  return scale;
 }
 
 SR_HALF void ExtrapolateHalfAvx512(Eigen::Index n, const float* base, float a,
@@ -83,10 +87,10 @@ SR_HALF void ExtrapolateHalfAvx512(Eigen::Index n, const float* base, float a,
 #define SR_F16C __attribute__((target("avx2,fma,f16c")))
 constexpr int kRound = _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC;
 
-SR_F16C float RoundToHalfF16c(Eigen::Index n, float* d, std::uint16_t* half) {
+SR_F16C bool LargestF16c(Eigen::Index n, const float* d, float* top) {
   const __m256 sign = _mm256_set1_ps(-0.0f);
   __m256 largest = _mm256_setzero_ps();
-  __m256 poison = _mm256_setzero_ps();  // as RoundToHalfAvx512's
+  __m256 poison = _mm256_setzero_ps();  // as LargestAvx512's
   Eigen::Index i = 0;
   for (; i + 8 <= n; i += 8) {
     const __m256 v = _mm256_loadu_ps(d + i);
@@ -96,13 +100,18 @@ SR_F16C float RoundToHalfF16c(Eigen::Index n, float* d, std::uint16_t* half) {
   alignas(32) float lanes[8], poisoned[8];
   _mm256_store_ps(lanes, largest);
   _mm256_store_ps(poisoned, poison);
-  float top = 0.0f, bad = 0.0f;
-  for (int l = 0; l < 8; ++l) top = std::max(top, lanes[l]), bad += poisoned[l];
-  for (Eigen::Index j = i; j < n; ++j) top = std::max(top, std::abs(d[j])), bad += d[j] * 0.0f;
-  if (std::isnan(bad)) return 0.0f;
-  const float scale = HalfScale(top);
+  float largest_entry = 0.0f, bad = 0.0f;
+  for (int l = 0; l < 8; ++l) largest_entry = std::max(largest_entry, lanes[l]), bad += poisoned[l];
+  for (Eigen::Index j = i; j < n; ++j)
+    largest_entry = std::max(largest_entry, std::abs(d[j])), bad += d[j] * 0.0f;
+  *top = largest_entry;
+  return !std::isnan(bad);
+}
+
+SR_F16C void ToHalfF16c(Eigen::Index n, float* d, std::uint16_t* half, float scale) {
   const __m256 up = _mm256_set1_ps(scale), down = _mm256_set1_ps(1.0f / scale);
-  for (i = 0; i + 8 <= n; i += 8) {
+  Eigen::Index i = 0;
+  for (; i + 8 <= n; i += 8) {
     const __m128i h = _mm256_cvtps_ph(_mm256_mul_ps(_mm256_loadu_ps(d + i), up), kRound);
     _mm_storeu_si128(reinterpret_cast<__m128i*>(half + i), h);
     _mm256_storeu_ps(d + i, _mm256_mul_ps(_mm256_cvtph_ps(h), down));
@@ -111,7 +120,6 @@ SR_F16C float RoundToHalfF16c(Eigen::Index n, float* d, std::uint16_t* half) {
     half[i] = _cvtss_sh(d[i] * scale, kRound);
     d[i] = _cvtsh_ss(half[i]) * (1.0f / scale);
   }
-  return scale;
 }
 
 SR_F16C void ExtrapolateHalfF16c(Eigen::Index n, const float* base, float a,
@@ -145,10 +153,35 @@ bool HasF16c() {
 
 bool HasHalfDifferences() { return HasLuSolveHalfAvx512() || HasF16c(); }
 
+// From this many entries on, RoundToHalf runs in two parts over the threads (the near
+// corrections' D₁, D₂ on a hundred helices: 9 × 140 000 entries, at each assembly and remap).
+constexpr Eigen::Index kParallelRound = 1 << 16;
+
 float RoundToHalf(Eigen::Index n, float* d, std::uint16_t* half, bool f16c) {
-  if (!f16c && HasLuSolveHalfAvx512()) return RoundToHalfAvx512(n, d, half);
-  SR_ASSERT(HasF16c(), "half precision needs AVX-512 BW or F16C");
-  return RoundToHalfF16c(n, d, half);
+  const bool wide = !f16c && HasLuSolveHalfAvx512();
+  SR_ASSERT(wide || HasF16c(), "half precision needs AVX-512 BW or F16C");
+  // Each part's largest |entry|, then each part rounded at the scale of the whole: the same bits
+  // on any number of threads.
+  const Eigen::Index cut = n >= kParallelRound ? (n / 2 + 15) / 16 * 16 : n;
+  float top[2] = {0.0f, 0.0f};
+  bool finite[2] = {true, true};
+#pragma omp parallel for schedule(static) if (cut < n)
+  for (int part = 0; part < 2; ++part) {
+    const Eigen::Index first = part == 0 ? 0 : cut, count = part == 0 ? cut : n - cut;
+    finite[part] = wide ? LargestAvx512(count, d + first, &top[part])
+                        : LargestF16c(count, d + first, &top[part]);
+  }
+  if (!finite[0] || !finite[1]) return 0.0f;
+  const float scale = HalfScale(std::max(top[0], top[1]));
+#pragma omp parallel for schedule(static) if (cut < n)
+  for (int part = 0; part < 2; ++part) {
+    const Eigen::Index first = part == 0 ? 0 : cut, count = part == 0 ? cut : n - cut;
+    if (wide)
+      ToHalfAvx512(count, d + first, half + first, scale);
+    else
+      ToHalfF16c(count, d + first, half + first, scale);
+  }
+  return scale;
 }
 
 void ExtrapolateHalf(Eigen::Index n, const float* base, float a, const std::uint16_t* slope,
