@@ -280,17 +280,23 @@ void FmmStokesletSum::PadSources(const Matrix3X& sources, const VecX& regulariza
 void FmmStokesletSum::Apply(const Matrix3X& strengths, Matrix3X* w) const {
   if (use_direct_) return direct_->Apply(strengths, w);
   SR_ASSERT(strengths.cols() == num_sources_, "one strength per source");
-  for (Eigen::Index s = 0; s < src_.rows(); ++s) {
+  // (The scatter and gather over the threads: on a hundred helices 13 000 sources and 6 500
+  // targets per product, 0.5 % of the samples with the second thread waiting.)
+  const Eigen::Index rows = src_.rows();
+#pragma omp parallel for schedule(static) if (rows > 4096)
+  for (Eigen::Index s = 0; s < rows; ++s) {
     const int k = slot_source_[static_cast<size_t>(s)];
     if (k >= 0) src_.row(s).tail<3>() = strengths.col(k).transpose();  // padding stays zero
+    if (single_) src_f_.row(s).tail<3>() = src_.row(s).tail<3>().cast<float>();
   }
-  if (single_) src_f_.rightCols<3>() = src_.rightCols<3>().cast<float>();
   Upward();
   Downward();
   Matrix3X sorted;
   Leaves(&sorted);
   w->resize(3, sorted.cols());
-  for (Eigen::Index t = 0; t < sorted.cols(); ++t)
+  const Eigen::Index targets = sorted.cols();
+#pragma omp parallel for schedule(static) if (targets > 4096)
+  for (Eigen::Index t = 0; t < targets; ++t)
     w->col(tree_.target_order[static_cast<size_t>(t)]) = sorted.col(t);
 }
 

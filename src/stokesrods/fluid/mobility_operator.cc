@@ -667,7 +667,10 @@ void MatrixFreeRssMobility::Apply(const VecX& force, VecX* velocity) const {
     const double* weight = nullptr;
     GaussLegendreRule01(g, &alpha, &weight);
     strengths_.resize(3, gauss_points_.cols());
-    for (std::size_t s = 0; s < segments_.size(); ++s) {
+    const auto num_segments = static_cast<std::ptrdiff_t>(segments_.size());
+#pragma omp parallel for schedule(static) if (num_segments > 4096)
+    for (std::ptrdiff_t si = 0; si < num_segments; ++si) {
+      const auto s = static_cast<std::size_t>(si);
       const int a = segments_[s].a;
       const double length = (nodes_.col(a + 1) - nodes_.col(a)).norm();
       const Vec3 fa = force.segment<3>(3 * a) * inverse_voronoi_(a);
