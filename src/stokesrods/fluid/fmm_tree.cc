@@ -324,18 +324,14 @@ FmmTree BuildFmmTree(const Matrix3X& sources, const Matrix3X& targets, double mi
   // (a uniform tree offers only extent / 2^depth), chosen by the estimated cost. The levels below
   // the estimate's depth are not built (when it counted every level it needed).
   // The three estimates over the threads, taken in order of k (the same choice on any count).
-  std::array<LeastCostDepth, 4> widened;
-  std::array<double, 4> widths{};
+  std::array<double, 3> widths{};
+  std::array<LeastCostDepth, 3> widened;
+  for (int k = 1; k < 4; ++k) widths[static_cast<size_t>(k - 1)] = extent * (1.0 + 1e-9) * std::exp2(0.25 * k);
 #pragma omp parallel for schedule(dynamic, 1)
-  for (int k = 1; k < 4; ++k) {
-    widths[static_cast<size_t>(k)] = extent * (1.0 + 1e-9) * std::exp2(0.25 * k);
-    widened[static_cast<size_t>(k)] =
-        LeastCost(sources, targets, tree.corner, widths[static_cast<size_t>(k)], min_leaf_width, cost);
-  }
-  for (int k = 1; k < 4; ++k) {
-    const LeastCostDepth& c = widened[static_cast<size_t>(k)];
-    if (c.complete && c.cost < least.cost) least = c, tree.width = widths[static_cast<size_t>(k)];
-  }
+  for (std::size_t i = 0; i < widths.size(); ++i)
+    widened[i] = LeastCost(sources, targets, tree.corner, widths[i], min_leaf_width, cost);
+  for (std::size_t i = 0; i < widths.size(); ++i)
+    if (widened[i].complete && widened[i].cost < least.cost) least = widened[i], tree.width = widths[i];
   const int max_level = least.complete && least.depth >= 2 ? least.depth : kMaxLevel;
   std::vector<std::uint64_t> src, tgt;
 #pragma omp parallel sections

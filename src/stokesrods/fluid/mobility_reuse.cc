@@ -14,9 +14,6 @@ namespace {
 // loops marked `omp simd`): one per step (forming the extrapolation) or per assembly (taking it
 // into the history), over all 9M² entries; as Eigen expressions they were 10 % of Fig. 1's step.
 
-// Extrapolations from this many entries on are split over two threads (Fig. 1: 152 100).
-constexpr Eigen::Index kParallelEntries = 1 << 16;
-
 // out = base + s · slope + c · curve (curve only when given; c = s (s + 1)), n entries.
 __attribute__((target_clones("avx512f", "avx2", "default")))
 void Extrapolate(Eigen::Index n, const float* base, float s, const float* slope, float c,
@@ -135,17 +132,13 @@ bool MobilityReuse::Update(const VecX& x, const Assemble& assemble, MatX* assemb
                   extrapolated->data());
       return false;
     }
-    // In two halves over the threads (a pass over memory: two cores stream it faster).
-    const Eigen::Index n = base_.size(), half = (n / 2 + 15) / 16 * 16;
     const auto a = static_cast<float>(s / slope_scale_);
     const auto b = static_cast<float>(s * (s + 1.0) / curve_scale_);
-#pragma omp parallel for schedule(static) if (n >= kParallelEntries)
-    for (int part = 0; part < 2; ++part) {
-      const Eigen::Index first = part * half, count = part == 0 ? half : n - half;
+    ForTwoParts(base_.size(), [&](int, Eigen::Index first, Eigen::Index count) {
       ExtrapolateHalf(count, base_.data() + first, a, slope_half_.data() + first, b,
-                            quadratic_ ? curve_half_.data() + first : nullptr,
-                            extrapolated->data() + first);
-    }
+                      quadratic_ ? curve_half_.data() + first : nullptr,
+                      extrapolated->data() + first);
+    });
     return false;
   }
   if (!same_size) Forget();
@@ -255,7 +248,7 @@ void MobilityReuse::Remap(const std::vector<int>& old_column, const AssembleColu
     return out;
   };
   // The matrices over the threads (passes over memory; on a hundred helices 5 MB each).
-#pragma omp parallel sections if (rows * cols >= kParallelEntries)
+#pragma omp parallel sections if (rows * cols >= kTwoPartsFrom)
   {
 #pragma omp section
     base_ = remap(base_, base);

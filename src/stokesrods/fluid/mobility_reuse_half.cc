@@ -153,34 +153,26 @@ bool HasF16c() {
 
 bool HasHalfDifferences() { return HasLuSolveHalfAvx512() || HasF16c(); }
 
-// From this many entries on, RoundToHalf runs in two parts over the threads (the near
-// corrections' D₁, D₂ on a hundred helices: 9 × 140 000 entries, at each assembly and remap).
-constexpr Eigen::Index kParallelRound = 1 << 16;
-
 float RoundToHalf(Eigen::Index n, float* d, std::uint16_t* half, bool f16c) {
   const bool wide = !f16c && HasLuSolveHalfAvx512();
   SR_ASSERT(wide || HasF16c(), "half precision needs AVX-512 BW or F16C");
   // Each part's largest |entry|, then each part rounded at the scale of the whole: the same bits
-  // on any number of threads.
-  const Eigen::Index cut = n >= kParallelRound ? (n / 2 + 15) / 16 * 16 : n;
+  // on any number of threads (on a hundred helices the near corrections' D₁, D₂, 9 × 140 000
+  // entries, at each assembly and remap).
   float top[2] = {0.0f, 0.0f};
   bool finite[2] = {true, true};
-#pragma omp parallel for schedule(static) if (cut < n)
-  for (int part = 0; part < 2; ++part) {
-    const Eigen::Index first = part == 0 ? 0 : cut, count = part == 0 ? cut : n - cut;
+  ForTwoParts(n, [&](int part, Eigen::Index first, Eigen::Index count) {
     finite[part] = wide ? LargestAvx512(count, d + first, &top[part])
                         : LargestF16c(count, d + first, &top[part]);
-  }
+  });
   if (!finite[0] || !finite[1]) return 0.0f;
   const float scale = HalfScale(std::max(top[0], top[1]));
-#pragma omp parallel for schedule(static) if (cut < n)
-  for (int part = 0; part < 2; ++part) {
-    const Eigen::Index first = part == 0 ? 0 : cut, count = part == 0 ? cut : n - cut;
+  ForTwoParts(n, [&](int, Eigen::Index first, Eigen::Index count) {
     if (wide)
       ToHalfAvx512(count, d + first, half + first, scale);
     else
       ToHalfF16c(count, d + first, half + first, scale);
-  }
+  });
   return scale;
 }
 

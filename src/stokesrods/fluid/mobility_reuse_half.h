@@ -12,6 +12,22 @@ namespace stokesrods {
 /// Whether this CPU runs the functions below: AVX-512 F, BW and VL, or AVX2, FMA and F16C.
 bool HasHalfDifferences();
 
+/// From this many entries on, the passes over the reuse's matrices run in two parts.
+inline constexpr Eigen::Index kTwoPartsFrom = Eigen::Index{1} << 16;
+
+/// body(part, first, count) over [0, n): in two parts cut at a multiple of 16 (whole vectors) and
+/// run over the OpenMP threads from kTwoPartsFrom entries on (a pass over memory: two cores
+/// stream it faster), else in one (part 0). Each part's entries are its own: an elementwise pass
+/// gives the same bits either way.
+template <class Body>
+void ForTwoParts(Eigen::Index n, const Body& body) {
+  if (n < kTwoPartsFrom) return body(0, Eigen::Index{0}, n);
+  const Eigen::Index cut = (n / 2 + 15) / 16 * 16;
+#pragma omp parallel for schedule(static)
+  for (int part = 0; part < 2; ++part)
+    body(part, part == 0 ? Eigen::Index{0} : cut, part == 0 ? cut : n - cut);
+}
+
 /// d (n entries) rounded to half precision at the scale σ, a power of two that puts its largest
 /// |entry| near 2¹⁴ (half precision's range ends at 65504): half = σ d in half precision, and d ←
 /// half / σ (exact in single precision), so that d holds what the half values stand for. Returns
