@@ -574,6 +574,75 @@ TEST(MobilityReuseHalf, RemappedColumnsContinueAsIfHeldFromTheStart) {
   RemapAgainstHeldFromTheStart(true);
 }
 
+// Row weights (the matrix-free operator's near blocks keep a symmetric 3 × 3 block's six entries,
+// the off-diagonal ones weighted 2): 300 symmetric blocks depending smoothly on the position
+// along a gently curved path, held as nine rows and as six. The six-row history measures the
+// nine-row one's errors (to rounding), so it assembles at the same steps and extrapolates the
+// same values; without the weights its measure differs. With half-precision differences (the
+// default from tolerance 1e-4) the same bits; with single-precision ones to float rounding (the
+// vectorized passes contract their multiply–adds by an entry's position in the vector: 6e-8 of
+// the largest entry, measured 0 or 1 ulp).
+void SymmetricBlocksAgainstFullOnes(bool half) {
+  const int blocks = 300;
+  std::mt19937 rng(17);
+  std::normal_distribution<double> normal;
+  MatX terms[3];
+  for (MatX& m : terms) m = MatX::NullaryExpr(6, blocks, [&](Eigen::Index, Eigen::Index) { return normal(rng); });
+  const auto six_rows = [&](double t) {  // the blocks' distinct entries at t
+    return MatX(terms[0] + std::sin(t) * terms[1] + 0.3 * t * t * terms[2]);
+  };
+  const auto nine_rows = [&](double t) {
+    const MatX e = six_rows(t);
+    MatX m(9, blocks);
+    for (Eigen::Index j = 0; j < blocks; ++j)
+      m.col(j) << e(0, j), e(1, j), e(2, j), e(1, j), e(3, j), e(4, j), e(2, j), e(4, j), e(5, j);
+    return m;
+  };
+  const int in_nine[6] = {0, 1, 2, 4, 5, 8};  // where each of the six sits in the nine
+  MobilityReuse nine(1e-4, half), six(1e-4, half), unweighted(1e-4, half);
+  six.set_row_weights({1.0, 2.0, 2.0, 1.0, 2.0, 1.0});
+  bool same_bits = true;
+  double worst = 0.0;  // of the extrapolated entries, relative to the largest
+  for (int k = 0; k < 150; ++k) {
+    const double t = 0.004 * k;
+    VecX x(6);
+    x << t, 0.05 * t * t, 1.0, -t, 0.0, 2.0;
+    MatX assembled;
+    Eigen::MatrixXf full, packed, other;
+    const bool a9 = nine.Update(x, [&](const VecX&, MatX* m) { *m = nine_rows(t); }, &assembled, &full);
+    const bool a6 = six.Update(x, [&](const VecX&, MatX* m) { *m = six_rows(t); }, &assembled, &packed);
+    unweighted.Update(x, [&](const VecX&, MatX* m) { *m = six_rows(t); }, &assembled, &other);
+    ASSERT_EQ(a9, a6) << "k " << k;
+    if (a9) continue;
+    for (int r = 0; r < 6; ++r) {
+      same_bits = same_bits && packed.row(r) == full.row(in_nine[r]);
+      worst = std::max(worst, static_cast<double>((packed.row(r) - full.row(in_nine[r]))
+                                                      .cwiseAbs().maxCoeff() /
+                                                  full.cwiseAbs().maxCoeff()));
+    }
+  }
+  if (half) {
+    EXPECT_TRUE(same_bits);
+  } else {
+    EXPECT_LT(worst, 2e-7);
+  }
+  EXPECT_EQ(six.stats().assemblies, nine.stats().assemblies) << "half " << half;
+  EXPECT_LT(nine.stats().assemblies, 150 / 3) << "half " << half;  // it did extrapolate
+  EXPECT_NEAR(six.stats().largest_error, nine.stats().largest_error,
+              (half ? 1e-12 : 1e-5) * nine.stats().largest_error) << "half " << half;
+  EXPECT_GT(std::abs(unweighted.stats().largest_error - nine.stats().largest_error),
+            1e-6 * nine.stats().largest_error) << "half " << half;
+}
+
+TEST(MobilityReuse, SymmetricBlocksWithRowWeightsMeasureAsTheFullOnes) {
+  SymmetricBlocksAgainstFullOnes(false);
+}
+
+TEST(MobilityReuseHalf, SymmetricBlocksWithRowWeightsMeasureAsTheFullOnes) {
+  if (!HasHalfDifferences()) GTEST_SKIP() << "neither AVX-512 BW nor F16C on this CPU";
+  SymmetricBlocksAgainstFullOnes(true);
+}
+
 // JUMPS: a geometry that does not continue the motion is assembled, whatever the interval: one
 // helix moved by 1 cm (across the line of the turn) or the turn taken 200 steps ahead (at least
 // 5 intervals of ≤ 40: past kMaxLinePosition), in the middle of an interval.

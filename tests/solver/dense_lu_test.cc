@@ -117,7 +117,7 @@ TEST(DenseLu, TheBlockedSingleSolveMatchesGetrs) {
   const std::vector<LuKernels> kernels = KernelsHere();
   if (kernels.empty()) GTEST_SKIP() << "neither AVX-512 nor AVX2 here: getrs is the only path";
   std::mt19937 rng(9);
-  for (const int n : {1, 5, 31, 32, 33, 63, 64, 65, 100, 390, 1023, 1024, 1100, 2400}) {
+  for (const int n : {1, 5, 31, 32, 33, 63, 64, 65, 100, 390, 1023, 1024, 1100, 1153, 2400}) {
     const Eigen::MatrixXf random = RandomMatrix<float>(n, &rng);
     const Eigen::MatrixXf dominant = ShuffledDominant(random, &rng);
     const Eigen::VectorXf b = RandomMatrix<float>(n, &rng).col(0);
@@ -165,7 +165,7 @@ TEST(DenseLu, TheBlockedSingleSolveDoesNotDependOnTheThreadCount) {
   Factor(a, &factors, &pivots);
   const int saved = omp_get_max_threads();
   for (const LuKernels& kernel : kernels) {
-    std::vector<std::uint16_t> half(static_cast<size_t>(n) * static_cast<size_t>(n));
+    std::vector<std::uint16_t> half(HalfFactorLayout(n).Size());
     float scale = 0.0f;
     if (kernel.half) {
       ASSERT_TRUE(kernel.to_half(n, factors.data(), half.data(), &scale));
@@ -199,7 +199,7 @@ TEST(DenseLu, HalfPrecisionFactorsSolveLikeTheirSinglePrecisionValues) {
                 kernels.end());
   if (kernels.empty()) GTEST_SKIP() << "neither AVX-512 BW nor F16C here: kHalf keeps floats";
   std::mt19937 rng(12);
-  for (const int n : {1, 5, 31, 32, 33, 64, 65, 195, 390, 1023, 1024, 1100, 2400}) {
+  for (const int n : {1, 5, 31, 32, 33, 64, 65, 195, 390, 1023, 1024, 1100, 1153, 2400}) {
     Eigen::MatrixXf a = RandomMatrix<float>(n, &rng) +
                         static_cast<float>(2 * n) * Eigen::MatrixXf::Identity(n, n);
     Eigen::PermutationMatrix<Eigen::Dynamic> shuffle(n);
@@ -226,7 +226,7 @@ TEST(DenseLu, HalfPrecisionFactorsSolveLikeTheirSinglePrecisionValues) {
     Factor(a, &factors, &pivots);
     std::vector<std::uint16_t> first;
     for (const LuKernels& kernel : kernels) {
-      std::vector<std::uint16_t> rounded(static_cast<size_t>(n) * static_cast<size_t>(n));
+      std::vector<std::uint16_t> rounded(HalfFactorLayout(n).Size());
       float scale = 0.0f;
       ASSERT_TRUE(kernel.to_half(n, factors.data(), rounded.data(), &scale));
       if (first.empty()) first = rounded;
@@ -237,7 +237,7 @@ TEST(DenseLu, HalfPrecisionFactorsSolveLikeTheirSinglePrecisionValues) {
       Eigen::MatrixXf widened(n, n);
       for (int j = 0; j < n; ++j)
         for (int i = 0; i < n; ++i)
-          widened(i, j) = Widen(rounded[static_cast<size_t>(i + j * n)]) / (i <= j ? scale : 1.0f);
+          widened(i, j) = Widen(rounded[HalfFactorIndex(n, i, j)]) / (i <= j ? scale : 1.0f);
       Eigen::VectorXf x_reference = b;
       kernel.solve(n, widened.data(), pivots.data(), x_reference.data());
       EXPECT_LT((x_kernel - x_reference).norm(), 1e-5f * x_reference.norm()) << kernel.name << n;
@@ -245,6 +245,58 @@ TEST(DenseLu, HalfPrecisionFactorsSolveLikeTheirSinglePrecisionValues) {
         EXPECT_EQ(x_kernel, x_half) << kernel.name << " " << n;  // DenseLu's is the widest
       }
     }
+  }
+}
+
+// The half factors' layout (lu_solve_avx512.h, LuPanels): every entry of the factors has its own
+// place within the layout's size (none shared, none outside), and ArrangeHalfFactors puts each
+// there; column-major below kParallelLuSolve; in tiles, each chunk and diagonal block a run of
+// consecutive places, L's blocks before U's. On sizes with a partial last block, a partial last
+// chunk, and both.
+TEST(DenseLu, HalfFactorLayoutPlacesEveryEntryOnce) {
+  for (const int n : {5, kParallelLuSolve - 1, kParallelLuSolve, 1100, 1153, 2400}) {
+    const LuPanels layout = HalfFactorLayout(n);
+    EXPECT_EQ(layout.tiled, n >= kParallelLuSolve) << n;
+    const std::size_t size = layout.Size();
+    EXPECT_GE(size, static_cast<std::size_t>(n) * n) << n;
+    EXPECT_LE(size, static_cast<std::size_t>(n) * n + 2 * static_cast<std::size_t>(n) * kLuWideBlock)
+        << n;
+    std::vector<std::uint16_t> column_major(static_cast<std::size_t>(n) * n), arranged(size, 7);
+    std::vector<char> taken(size, 0);
+    bool inside = true, once = true, placed = true;
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        // A value of its own per entry (mod 2¹⁶: checked over the first 65 536 only).
+        column_major[static_cast<std::size_t>(i) + static_cast<std::size_t>(j) * n] =
+            static_cast<std::uint16_t>((i + j * n) & 0xffff);
+      }
+    ArrangeHalfFactors(n, column_major.data(), arranged.data());
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const std::size_t at = HalfFactorIndex(n, i, j);
+        if (at >= size) {
+          inside = false;
+          continue;
+        }
+        once = once && !taken[at];
+        taken[at] = 1;
+        placed = placed && arranged[at] == static_cast<std::uint16_t>((i + j * n) & 0xffff);
+      }
+    EXPECT_TRUE(inside) << n;
+    EXPECT_TRUE(once) << n;
+    EXPECT_TRUE(placed) << n;
+    if (!layout.tiled) {
+      EXPECT_EQ(HalfFactorIndex(n, 3, 4), static_cast<std::size_t>(3 + 4 * n));
+      continue;
+    }
+    // Tiled: the chunk of L's first block from row kLuWideBlock, and U's last (top) block's
+    // diagonal, where the layout says; a chunk's column follows its previous column.
+    EXPECT_EQ(HalfFactorIndex(n, kLuWideBlock, 0), layout.LowerChunk(0, kLuWideBlock, kLuWideBlock));
+    EXPECT_EQ(HalfFactorIndex(n, kLuWideBlock + 1, 1),
+              HalfFactorIndex(n, kLuWideBlock + 1, 0) + std::min(kLuChunkRows, n - kLuWideBlock));
+    EXPECT_EQ(HalfFactorIndex(n, 0, 0), layout.UpperDiagonal(0, n - (n - 1) / kLuWideBlock * kLuWideBlock));
+    EXPECT_EQ(HalfFactorIndex(n, 1, 0), layout.LowerDiagonal(0) + 1);
+    EXPECT_LT(HalfFactorIndex(n, n - 1, n - 2), HalfFactorIndex(n, 0, n - 1));  // L before U
   }
 }
 

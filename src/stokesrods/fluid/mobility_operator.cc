@@ -122,8 +122,14 @@ class DenseMobility final : public MobilityOperator {
   const Eigen::MatrixXf* products_ = nullptr;  // 𝕄 the products take in single precision, if so
 };
 
+// A symmetric block's six entries in single precision (NearBlocks::SymmetricBlock).
+NearBlocks::SymmetricBlock PackSymmetric(const Mat3& b) {
+  return {static_cast<float>(b(0, 0)), static_cast<float>(b(1, 0)), static_cast<float>(b(2, 0)),
+          static_cast<float>(b(1, 1)), static_cast<float>(b(2, 1)), static_cast<float>(b(2, 2))};
+}
+
 // out (compressed rows) from the blocks per target, packed in parallel (in single precision if
-// `single`).
+// `single`, each symmetric block's six entries).
 void PackNearBlocks(const std::vector<std::vector<std::pair<int, Mat3>>>& per_target, bool single,
                     NearBlocks* out) {
   const int m = static_cast<int>(per_target.size());
@@ -137,17 +143,22 @@ void PackNearBlocks(const std::vector<std::vector<std::pair<int, Mat3>>>& per_ta
   out->single = single;
   out->block.resize(single ? 0 : count);
   out->block_single.resize(single ? count : 0);
-#pragma omp parallel for schedule(static)
+  bool symmetric = true;
+#pragma omp parallel for schedule(static) reduction(&& : symmetric)
   for (int t = 0; t < m; ++t) {
     auto k = static_cast<size_t>(out->start[static_cast<size_t>(t)]);
     for (const auto& [node, block] : per_target[static_cast<size_t>(t)]) {
       out->source[k] = node;
-      if (single)
-        out->block_single[k++] = block.cast<float>();
-      else
+      if (single) {
+        symmetric = symmetric && block(0, 1) == block(1, 0) && block(0, 2) == block(2, 0) &&
+                    block(1, 2) == block(2, 1);
+        out->block_single[k++] = PackSymmetric(block);
+      } else {
         out->block[k++] = block;
+      }
     }
   }
+  SR_ASSERT(symmetric, "a near block in single precision is not symmetric");
 }
 
 // Matrix-free RSS (see the header). With f_j = F_j/Λ_j the force densities at the nodes,
@@ -182,6 +193,8 @@ class MatrixFreeRssMobility final : public MobilityOperator {
         near_reuse_(reuse_near_ ? options.reuse_tolerance : 0.0,
                     options.reuse_tolerance >= kSinglePrecisionTolerance),
         near_reuse_tolerance_(reuse_near_ ? options.reuse_tolerance : 0.0) {
+    // The blocks' six entries stand for the nine of a 3 × 3 block in the reuse's error measure.
+    near_reuse_.set_row_weights({1.0, 2.0, 2.0, 1.0, 2.0, 1.0});
     SR_ASSERT(!params.wall, "the matrix-free RSS is the free-space operator: a wall's images wrap "
                             "it (MakeMobilityWithWallImages, fluid/wall_sources.h)");
   }
@@ -534,15 +547,17 @@ void MatrixFreeRssMobility::RemapNearHistory(const NearBlocks& pattern) {
     Eigen::Index count = 0;
     for (const int t : changed)
       count += static_cast<Eigen::Index>(blocks[static_cast<size_t>(t)].size());
-    columns->resize(9, count);
+    columns->resize(6, count);
     Eigen::Index j = 0;
     for (const int t : changed) {
       const auto& list = blocks[static_cast<size_t>(t)];
       SR_ASSERT(static_cast<int>(list.size()) == pattern.start[static_cast<size_t>(t) + 1] -
                                                      pattern.start[static_cast<size_t>(t)],
                 "the near pattern and its blocks disagree");
-      for (const auto& [node, block] : list)  // in single precision, as the assemblies
-        columns->col(j++) = block.cast<float>().reshaped().cast<double>();
+      for (const auto& [node, block] : list) {  // in single precision, as the assemblies
+        const NearBlocks::SymmetricBlock packed = PackSymmetric(block);
+        columns->col(j++) = Eigen::Map<const Eigen::Matrix<float, 6, 1>>(packed.data()).cast<double>();
+      }
     }
   };
   near_reuse_.Remap(old_column, assemble);
@@ -583,7 +598,7 @@ void MatrixFreeRssMobility::UpdateNearBlocks() {
       near_reuse_.set_tolerance(near_reuse_tolerance_ *
                                 (exact2 > 0.0 ? std::sqrt(difference / exact2) : 1.0));
     }
-    *values = Eigen::Map<const Eigen::MatrixXf>(near_.block_single.front().data(), 9, count)
+    *values = Eigen::Map<const Eigen::MatrixXf>(near_.block_single.front().data(), 6, count)
                   .cast<double>();
   };
   if (count == 0) {  // no near pairs at all: nothing to compute or reuse
@@ -597,7 +612,7 @@ void MatrixFreeRssMobility::UpdateNearBlocks() {
   near_.single = true;
   near_.block.clear();
   near_.block_single.resize(static_cast<size_t>(count));
-  Eigen::Map<Eigen::MatrixXf>(near_.block_single.front().data(), 9, count) = extrapolated;
+  Eigen::Map<Eigen::MatrixXf>(near_.block_single.front().data(), 6, count) = extrapolated;
 }
 
 void MatrixFreeRssMobility::NearPairBlocks(const Vec3& p, const std::vector<int>& near,

@@ -18,6 +18,7 @@
 // matrix-free operator wrapped by fluid/mobility_sources.h).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -39,12 +40,18 @@ enum class MobilityKind { kDense, kMatrixFree };
 /// segment near t (δ below the split's near radius), its closed forms minus the far rule, per node.
 /// The blocks are kept in single precision (block_single) where the operator's far field is
 /// summed in single precision (fast_sum_tolerance ≥ kSinglePrecisionTolerance): their rounding,
-/// 6e-8 relative, is far below that sum's; each product streams half the bytes (on 100 helices
-/// 1.4 M blocks, 100 MB in double, read by every product), summed in double.
+/// 6e-8 relative, is far below that sum's; each product streams a third of the bytes of a double
+/// 3 × 3 block (on 100 helices 138 000 blocks, read by every product), summed in double. In single
+/// precision a block keeps its six distinct entries: the RSS near blocks are symmetric (a
+/// regularized Stokeslet's tensor integrated against a hat function, times 1/Λ: PackNearBlocks
+/// checks it), and the product reads each off-diagonal entry for both of its places, as a full
+/// block's product would (the same sums).
 struct NearBlocks {
+  /// A symmetric block's entries (0,0), (1,0), (2,0), (1,1), (2,1), (2,2).
+  using SymmetricBlock = std::array<float, 6>;
   std::vector<int> start = {0}, source;
   std::vector<Mat3> block;                    ///< in double, unless single
-  std::vector<Eigen::Matrix3f> block_single;  ///< in single precision, if single
+  std::vector<SymmetricBlock> block_single;   ///< in single precision, if single
   bool single = false;
   std::size_t size() const { return source.size(); }
   /// The correction at target t for the nodal forces F (3M).
@@ -54,11 +61,11 @@ struct NearBlocks {
     if (single) {  // written out: Eigen's mixed product goes through a temporary and a loop
       double ux = 0.0, uy = 0.0, uz = 0.0;
       for (int k = begin; k < end; ++k) {
-        const float* b = block_single[static_cast<size_t>(k)].data();  // column-major
+        const float* b = block_single[static_cast<size_t>(k)].data();
         const double* f = force.data() + 3 * source[static_cast<size_t>(k)];
-        ux += double(b[0]) * f[0] + double(b[3]) * f[1] + double(b[6]) * f[2];
-        uy += double(b[1]) * f[0] + double(b[4]) * f[1] + double(b[7]) * f[2];
-        uz += double(b[2]) * f[0] + double(b[5]) * f[1] + double(b[8]) * f[2];
+        ux += double(b[0]) * f[0] + double(b[1]) * f[1] + double(b[2]) * f[2];
+        uy += double(b[1]) * f[0] + double(b[3]) * f[1] + double(b[4]) * f[2];
+        uz += double(b[2]) * f[0] + double(b[4]) * f[1] + double(b[5]) * f[2];
       }
       u = Vec3(ux, uy, uz);
     } else {

@@ -35,6 +35,7 @@ struct TakePass {
   bool new_slope = false; ///< slope = exact − base (there is a base)
   bool new_curve = false; ///< curve = (slope_new − alpha · slope) · beta (there is a slope)
   double alpha = 0.0, beta = 0.0;
+  const std::vector<double>* row_weights = nullptr;  ///< each row's weight in the sums, if any
 };
 
 // An assembled 𝕄 taken into the history in one pass: returns the squared miss
@@ -47,12 +48,26 @@ double TakeAssembly(Eigen::Index n, const double* exact, const TakePass& p, floa
   if (p.measure) {
     const double cc = p.use_curve ? p.c : 0.0;
     const float* q = p.use_curve ? curve : slope;  // cc = 0 reads slope twice instead of curve
+    const auto miss = [&](Eigen::Index i) {
+      return static_cast<double>(base[i]) + p.s * static_cast<double>(slope[i]) +
+             cc * static_cast<double>(q[i]) - exact[i];
+    };
+    if (p.row_weights) {  // column by column, each row weighted
+      const std::vector<double>& w = *p.row_weights;
+      const auto rows = static_cast<Eigen::Index>(w.size());
+      for (Eigen::Index first = 0; first < n; first += rows)
+        for (Eigen::Index r = 0; r < rows; ++r) {
+          const double d = miss(first + r), e = exact[first + r];
+          sum += w[static_cast<size_t>(r)] * d * d;
+          exact2 += w[static_cast<size_t>(r)] * e * e;
+        }
+    } else {
 #pragma omp simd reduction(+ : sum, exact2)
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const double d = static_cast<double>(base[i]) + p.s * static_cast<double>(slope[i]) +
-                       cc * static_cast<double>(q[i]) - exact[i];
-      sum += d * d;
-      exact2 += exact[i] * exact[i];
+      for (Eigen::Index i = 0; i < n; ++i) {
+        const double d = miss(i);
+        sum += d * d;
+        exact2 += exact[i] * exact[i];
+      }
     }
   }
   *norm2 = exact2;
@@ -160,6 +175,11 @@ void MobilityReuse::Take(const VecX& x, const MatX& assembled, bool measure) {
   }
   TakePass pass;
   pass.measure = measure;
+  if (!row_weights_.empty()) {
+    SR_ASSERT(assembled.rows() == static_cast<Eigen::Index>(row_weights_.size()),
+              "MobilityReuse: the row weights do not fit the matrix");
+    pass.row_weights = &row_weights_;
+  }
   // What the extrapolation gives here, since_ + 1 updates from the last assembly (one more than
   // the farthest used, so it bounds them), rounding included.
   if (measure) {

@@ -76,6 +76,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "stokesrods/common/types.h"
@@ -135,6 +136,10 @@ class MobilityReuse {
   void Forget();
   /// The tolerance from now on (the next assembly measures against it and sets the interval).
   void set_tolerance(double tolerance) { tolerance_ = tolerance; }
+  /// The matrix's columns hold `weights.size()` rows, row r standing for weights[r] entries in
+  /// the Frobenius norms of e (the near corrections' symmetric blocks keep an off-diagonal entry
+  /// once for its two places: weight 2). None (the default): every entry once.
+  void set_row_weights(std::vector<double> weights) { row_weights_ = std::move(weights); }
   /// The history as a checkpoint keeps it.
   MobilityReuseHistory history() const;
   /// Takes a history kept by history(): the next Update assembles 𝕄 at its geometries first, then
@@ -170,6 +175,7 @@ class MobilityReuse {
   bool half_current_ = false;  ///< slope_half_ (and curve_half_ if quadratic_) hold D₁, D₂
   std::vector<std::uint16_t> slope_half_, curve_half_;  ///< σ₁ D₁, σ₂ D₂ in half precision
   float slope_scale_ = 1.0f, curve_scale_ = 1.0f;       ///< σ₁, σ₂: powers of two
+  std::vector<double> row_weights_;  ///< each row's weight in e's norms (set_row_weights)
   std::optional<MobilityReuseHistory> restore_;  ///< to assemble again at the next Update
   MobilityReuseStats stats_;
 };

@@ -139,7 +139,7 @@ bool DenseLu<Scalar>::Compute(Matrix a, LuStorage storage) {
   SR_ASSERT(info >= 0, "DenseLu: bad argument to getrf");
   if constexpr (std::is_same_v<Scalar, float>) {
     if (info == 0 && storage == LuStorage::kHalf && (HasLuSolveHalfAvx512() || HasLuSolveAvx2())) {
-      half_.resize(static_cast<std::size_t>(lu_.size()));
+      half_.resize(HalfFactorLayout(n).Size());
       const bool converted = HasLuSolveHalfAvx512()
                                  ? ConvertLuToHalf(n, lu_.data(), half_.data(), &half_scale_)
                                  : ConvertLuToHalfF16c(n, lu_.data(), half_.data(), &half_scale_);

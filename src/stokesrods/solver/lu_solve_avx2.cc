@@ -123,17 +123,17 @@ SR_AVX2_INLINE void ScaleForU(int n, float u_scale, float* x) {
 // there became a library call (__gnu_h2f_ieee, which the fuzzer's link lacks). Called from the
 // region, these keep theirs.
 #define SR_AVX2_CALLED __attribute__((target("avx2,fma,f16c"), noinline))
-// L's columns [j0, j1) within their block: x[j + 1, j1) −= x_j L(j + 1 … j1 − 1, j).
+// The triangle of a block of w columns, d its diagonal block (leading dimension ld) and x its
+// rows: L's, x[k + 1, w) −= x_k L(k + 1 … w − 1, k); U's from the bottom.
 template <class E>
-SR_AVX2_CALLED void LowerTriangle(int j0, int j1, const E* lu, Eigen::Index ld, float* x) {
-  for (int j = j0; j < j1; ++j) AxpyShort(j1 - j - 1, lu + j + 1 + j * ld, x[j], x + j + 1);
+SR_AVX2_CALLED void LowerTriangle(int w, const E* d, Eigen::Index ld, float* x) {
+  for (int k = 0; k < w; ++k) AxpyShort(w - k - 1, d + k + 1 + k * ld, x[k], x + k + 1);
 }
-// U's columns [j0, j1) within their block, from the bottom.
 template <class E>
-SR_AVX2_CALLED void UpperTriangle(int j0, int j1, const E* lu, Eigen::Index ld, float* x) {
-  for (int j = j1 - 1; j >= j0; --j) {
-    x[j] /= ToFloat(lu[j + j * ld]);
-    AxpyShort(j - j0, lu + j0 + j * ld, x[j], x + j0);
+SR_AVX2_CALLED void UpperTriangle(int w, const E* d, Eigen::Index ld, float* x) {
+  for (int k = w - 1; k >= 0; --k) {
+    x[k] /= ToFloat(d[k + k * ld]);
+    AxpyShort(k, d + k * ld, x[k], x);
   }
 }
 template <class E>
@@ -147,32 +147,37 @@ SR_AVX2_CALLED void ScaleForUCalled(int n, float u_scale, float* x) {
 }
 #undef SR_AVX2_CALLED
 
+// Single-precision factors column-major, half ones in tiles (LuPanels).
 template <class E>
 SR_AVX2 void LuSolveParallel(int n, const E* lu, const int* pivots, float u_scale, float* x) {
   for (int i = 0; i < n; ++i)
     if (pivots[i] - 1 != i) std::swap(x[i], x[pivots[i] - 1]);
-  const Eigen::Index ld = n;
+  const LuPanels panels{.n = n, .tiled = std::is_same_v<E, std::uint16_t>};
 #pragma omp parallel
   {
     for (int j0 = 0; j0 < n; j0 += kLuWideBlock) {  // L (unit diagonal), from the top
-      const int j1 = std::min(j0 + kLuWideBlock, n);
+      const int j1 = std::min(j0 + kLuWideBlock, n), w = j1 - j0;
 #pragma omp single
-      LowerTriangle(j0, j1, lu, ld, x);
+      LowerTriangle(w, lu + panels.LowerDiagonal(j0), panels.DiagonalStride(w), x + j0);
 #pragma omp for schedule(static)
-      for (int r = j1; r < n; r += kLuChunkRows)
-        SubtractColumnsCalled(std::min(kLuChunkRows, n - r), j1 - j0, lu + r + j0 * ld, ld,
+      for (int r = j1; r < n; r += kLuChunkRows) {
+        const int rows = std::min(kLuChunkRows, n - r);
+        SubtractColumnsCalled(rows, w, lu + panels.LowerChunk(j0, j1, r), panels.ChunkStride(rows),
                               x + j0, x + r);
+      }
     }
 #pragma omp single
     ScaleForUCalled<E>(n, u_scale, x);
     for (int j1 = n; j1 > 0; j1 -= kLuWideBlock) {  // U, from the bottom
-      const int j0 = std::max(j1 - kLuWideBlock, 0);
+      const int j0 = std::max(j1 - kLuWideBlock, 0), w = j1 - j0;
 #pragma omp single
-      UpperTriangle(j0, j1, lu, ld, x);
+      UpperTriangle(w, lu + panels.UpperDiagonal(j0, j1), panels.DiagonalStride(w), x + j0);
 #pragma omp for schedule(static)
-      for (int r = 0; r < j0; r += kLuChunkRows)
-        SubtractColumnsCalled(std::min(kLuChunkRows, j0 - r), j1 - j0, lu + r + j0 * ld, ld,
+      for (int r = 0; r < j0; r += kLuChunkRows) {
+        const int rows = std::min(kLuChunkRows, j0 - r);
+        SubtractColumnsCalled(rows, w, lu + panels.UpperChunk(j0, j1, r), panels.ChunkStride(rows),
                               x + j0, x + r);
+      }
     }
   }
 }
@@ -185,13 +190,13 @@ SR_AVX2 void LuSolve(int n, const E* lu, const int* pivots, float u_scale, float
   const Eigen::Index ld = n;
   for (int j0 = 0; j0 < n; j0 += kLuBlock) {  // L (unit diagonal), blocks from the top
     const int j1 = std::min(j0 + kLuBlock, n);
-    LowerTriangle(j0, j1, lu, ld, x);
+    LowerTriangle(j1 - j0, lu + j0 + j0 * ld, ld, x + j0);
     SubtractPanel(n - j1, j1 - j0, lu + j1 + j0 * ld, ld, x + j0, x + j1);
   }
   ScaleForU<E>(n, u_scale, x);
   for (int j1 = n; j1 > 0; j1 -= kLuBlock) {  // U, blocks from the bottom
     const int j0 = std::max(j1 - kLuBlock, 0);
-    UpperTriangle(j0, j1, lu, ld, x);
+    UpperTriangle(j1 - j0, lu + j0 + j0 * ld, ld, x + j0);
     SubtractPanel(j0, j1 - j0, lu + j0 * ld, ld, x + j0, x);
   }
 }
@@ -207,7 +212,7 @@ void LuSolveHalfAvx2(int n, const std::uint16_t* half, const int* pivots, float 
   LuSolve(n, half, pivots, u_scale, x);
 }
 
-SR_AVX2 bool ConvertLuToHalfF16c(int n, const float* lu, std::uint16_t* half, float* u_scale) {
+SR_AVX2 bool RoundLuToHalfF16c(int n, const float* lu, std::uint16_t* half, float* u_scale) {
   const Eigen::Index ld = n;
   float largest = 0.0f;
   for (int j = 0; j < n; ++j)
@@ -233,7 +238,7 @@ bool HasLuSolveAvx2() {
 #else
 void LuSolveAvx2(int, const float*, const int*, float*) {}
 void LuSolveHalfAvx2(int, const std::uint16_t*, const int*, float, float*) {}
-bool ConvertLuToHalfF16c(int, const float*, std::uint16_t*, float*) { return false; }
+bool RoundLuToHalfF16c(int, const float*, std::uint16_t*, float*) { return false; }
 bool HasLuSolveAvx2() { return false; }
 #endif
 

@@ -236,39 +236,47 @@ SR_HALF void LuSolveHalfParallel(int n, const std::uint16_t* lu, const int* pivo
                                  float* x) {
   for (int i = 0; i < n; ++i)
     if (pivots[i] - 1 != i) std::swap(x[i], x[pivots[i] - 1]);
-  const Eigen::Index ld = n;
+  const LuPanels panels = HalfFactorLayout(n);  // tiles (lu_solve_avx512.h)
 #pragma omp parallel
   {
     for (int j0 = 0; j0 < n; j0 += kWideBlock) {  // L (unit diagonal), from the top
-      const int j1 = std::min(j0 + kWideBlock, n);
+      const int j1 = std::min(j0 + kWideBlock, n), w = j1 - j0;
+      const std::uint16_t* d = lu + panels.LowerDiagonal(j0);
+      const std::ptrdiff_t ld = panels.DiagonalStride(w);
 #pragma omp single
-      for (int j = j0; j < j1; ++j)
-        SubtractColumnsHalf(j1 - j - 1, 1, lu + j + 1 + j * ld, ld, x + j, x + j + 1);
+      for (int k = 0; k < w; ++k)
+        SubtractColumnsHalf(w - k - 1, 1, d + k + 1 + k * ld, ld, x + j0 + k, x + j0 + k + 1);
 #pragma omp for schedule(static)
-      for (int r = j1; r < n; r += kChunkRows)
-        SubtractColumnsHalf(std::min(kChunkRows, n - r), j1 - j0, lu + r + j0 * ld, ld, x + j0,
-                            x + r);
+      for (int r = j1; r < n; r += kChunkRows) {
+        const int rows = std::min(kChunkRows, n - r);
+        SubtractColumnsHalf(rows, w, lu + panels.LowerChunk(j0, j1, r), panels.ChunkStride(rows),
+                            x + j0, x + r);
+      }
     }
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) x[i] *= u_scale;
     for (int j1 = n; j1 > 0; j1 -= kWideBlock) {  // U, from the bottom
-      const int j0 = std::max(j1 - kWideBlock, 0);
+      const int j0 = std::max(j1 - kWideBlock, 0), w = j1 - j0;
+      const std::uint16_t* d = lu + panels.UpperDiagonal(j0, j1);
+      const std::ptrdiff_t ld = panels.DiagonalStride(w);
 #pragma omp single
-      for (int j = j1 - 1; j >= j0; --j) {
-        x[j] /= HalfToFloat(lu[j + j * ld]);
-        SubtractColumnsHalf(j - j0, 1, lu + j0 + j * ld, ld, x + j, x + j0);
+      for (int k = w - 1; k >= 0; --k) {
+        x[j0 + k] /= HalfToFloat(d[k + k * ld]);
+        SubtractColumnsHalf(k, 1, d + k * ld, ld, x + j0 + k, x + j0);
       }
 #pragma omp for schedule(static)
-      for (int r = 0; r < j0; r += kChunkRows)
-        SubtractColumnsHalf(std::min(kChunkRows, j0 - r), j1 - j0, lu + r + j0 * ld, ld, x + j0,
-                            x + r);
+      for (int r = 0; r < j0; r += kChunkRows) {
+        const int rows = std::min(kChunkRows, j0 - r);
+        SubtractColumnsHalf(rows, w, lu + panels.UpperChunk(j0, j1, r), panels.ChunkStride(rows),
+                            x + j0, x + r);
+      }
     }
   }
 }
 
 }  // namespace
 
-SR_HALF bool ConvertLuToHalf(int n, const float* lu, std::uint16_t* half, float* u_scale) {
+SR_HALF bool RoundLuToHalfAvx512(int n, const float* lu, std::uint16_t* half, float* u_scale) {
   const Eigen::Index ld = n;
   float largest = 0.0f;
   for (int j = 0; j < n; ++j)
@@ -331,7 +339,7 @@ bool HasLuSolveHalfAvx512() {
 #else
 void LuSolveAvx512(int, const float*, const int*, float*) {}
 bool HasLuSolveAvx512() { return false; }
-bool ConvertLuToHalf(int, const float*, std::uint16_t*, float*) { return false; }
+bool RoundLuToHalfAvx512(int, const float*, std::uint16_t*, float*) { return false; }
 void LuSolveHalfAvx512(int, const std::uint16_t*, const int*, float, float*) {}
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic pop
