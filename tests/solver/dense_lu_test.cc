@@ -285,6 +285,9 @@ TEST(DenseLu, HalfFactorLayoutPlacesEveryEntryOnce) {
     EXPECT_TRUE(inside) << n;
     EXPECT_TRUE(once) << n;
     EXPECT_TRUE(placed) << n;
+    bool rest_zero = true;  // the places no entry takes (the diagonal blocks' unread halves)
+    for (std::size_t at = 0; at < size; ++at) rest_zero = rest_zero && (taken[at] || arranged[at] == 0);
+    EXPECT_TRUE(rest_zero) << n;
     if (!layout.tiled) {
       EXPECT_EQ(HalfFactorIndex(n, 3, 4), static_cast<std::size_t>(3 + 4 * n));
       continue;

@@ -310,9 +310,9 @@ class MatrixFreeRssMobility final : public MobilityOperator {
   Matrix3X gauss_points_;           // 3 × (segments × points)
   VecX gauss_eps_;
   NearBlocks near_;                 // the near corrections at the nodes
-  // Their values (9 × blocks) reused across Updates while the pattern holds (fluid/
-  // mobility_reuse.h, at the dense 𝕄's reuse tolerance, where the far sum is in single
-  // precision); forgotten at restart points and when the split changes, so a resumed run
+  // Their values (6 × blocks: NearBlocks::SymmetricBlock) reused across Updates while the
+  // pattern holds (fluid/mobility_reuse.h, at the dense 𝕄's reuse tolerance, where the far sum
+  // is in single precision); forgotten at restart points and when the split changes, so a resumed run
   // extrapolates as the uninterrupted one.
   bool reuse_near_;
   MobilityReuse near_reuse_;
@@ -556,7 +556,8 @@ void MatrixFreeRssMobility::RemapNearHistory(const NearBlocks& pattern) {
                 "the near pattern and its blocks disagree");
       for (const auto& [node, block] : list) {  // in single precision, as the assemblies
         const NearBlocks::SymmetricBlock packed = PackSymmetric(block);
-        columns->col(j++) = Eigen::Map<const Eigen::Matrix<float, 6, 1>>(packed.data()).cast<double>();
+        columns->col(j++) =
+            Eigen::Map<const Eigen::Matrix<float, 6, 1>>(packed.data()).cast<double>();
       }
     }
   };

@@ -157,7 +157,7 @@ float RoundToHalf(Eigen::Index n, float* d, std::uint16_t* half, bool f16c) {
   const bool wide = !f16c && HasLuSolveHalfAvx512();
   SR_ASSERT(wide || HasF16c(), "half precision needs AVX-512 BW or F16C");
   // Each part's largest |entry|, then each part rounded at the scale of the whole: the same bits
-  // on any number of threads (on a hundred helices the near corrections' D₁, D₂, 9 × 140 000
+  // on any number of threads (on a hundred helices the near corrections' D₁, D₂, 6 × 138 000
   // entries, at each assembly and remap).
   float top[2] = {0.0f, 0.0f};
   bool finite[2] = {true, true};

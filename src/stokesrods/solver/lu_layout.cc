@@ -41,7 +41,7 @@ void ArrangeHalfFactors(int n, const std::uint16_t* column_major, std::uint16_t*
     std::copy_n(column_major, panels.Size(), out);
     return;
   }
-  std::fill_n(out, panels.Size(), std::uint16_t{0});
+  // Every place is written once below but the diagonal blocks' unread halves, zeroed there.
   // Rows [first, end) of column j into the chunks from `first` of a block (its column `column`);
   // `chunk(r)` is where the chunk from row r starts.
   const auto to_chunks = [&](int j, int first, int end, std::size_t column, const auto& chunk) {
@@ -54,6 +54,7 @@ void ArrangeHalfFactors(int n, const std::uint16_t* column_major, std::uint16_t*
   for (int j0 = 0; j0 < n; j0 += kLuWideBlock) {  // L: strictly lower parts, then rows below
     const int j1 = std::min(j0 + kLuWideBlock, n);
     const auto w = static_cast<std::size_t>(j1 - j0);
+    std::fill_n(out + panels.LowerDiagonal(j0), w * w, std::uint16_t{0});
     for (int j = j0; j < j1; ++j) {
       const auto column = static_cast<std::size_t>(j - j0);
       const std::uint16_t* in = column_major + static_cast<std::size_t>(j) * n;
@@ -64,6 +65,7 @@ void ArrangeHalfFactors(int n, const std::uint16_t* column_major, std::uint16_t*
   for (int j1 = n; j1 > 0; j1 -= kLuWideBlock) {  // U: upper parts with the diagonal, rows above
     const int j0 = std::max(j1 - kLuWideBlock, 0);
     const auto w = static_cast<std::size_t>(j1 - j0);
+    std::fill_n(out + panels.UpperDiagonal(j0, j1), w * w, std::uint16_t{0});
     for (int j = j0; j < j1; ++j) {
       const auto column = static_cast<std::size_t>(j - j0);
       const std::uint16_t* in = column_major + static_cast<std::size_t>(j) * n;

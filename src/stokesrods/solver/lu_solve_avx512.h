@@ -99,9 +99,8 @@ bool HasLuSolveAvx512();
 /// The factors of LuSolveAvx512 in IEEE half precision (lu_solve_avx512.cc): L as it is (|L| ≤ 1
 /// with partial pivoting), U times `u_scale`, a power of two that puts its largest entry near
 /// 2¹⁴ (half precision's range ends at 65504), HalfFactorLayout(n).Size() entries where
-/// HalfFactorIndex says. Returns
-/// false (and writes nothing) when U has an entry that is not finite. Precondition:
-/// HasLuSolveHalfAvx512().
+/// HalfFactorIndex says. Returns false (and writes nothing) when U has an entry that is not
+/// finite. Precondition: HasLuSolveHalfAvx512().
 bool ConvertLuToHalf(int n, const float* lu, std::uint16_t* half, float* u_scale);
 /// x ← A⁻¹ x from ConvertLuToHalf's factors: the substitution of LuSolveAvx512, each entry
 /// widened to single precision as it is read (the arithmetic stays single): LuSolveAvx512 on the
