@@ -3,6 +3,7 @@
 // tip position at t = 0.16 s against a run at h/32, for h = 20, 10, 5 ms.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -48,6 +49,46 @@ TEST(IntegratorOrder, Bdf2IsSecondOrder) {
   const std::vector<double> p = ObservedOrders("bdf2");
   std::printf("BDF2: observed orders %.2f %.2f\n", p[0], p[1]);
   EXPECT_NEAR(p[1], 2.0, 0.3);
+}
+
+// The predictor's guess with its edges at their extrapolated lengths (ExtrapolateEdgeLengths):
+// on a helix clamped at its first two nodes, a guess stretched, turned and with its fixed nodes
+// and twists moved by the step. Every free edge takes the length 2|e_k| − |e_{k−1}| (q_{k−1}
+// shrunk by 2 % about the origin, so 1.02 |e_k|), or |e_k| without q_{k−1}, and points from its
+// first node (as placed) at its second node's guessed position; the fixed nodes' positions and
+// all twist angles stay as guessed.
+TEST(Predictor, SetsEachEdgeToItsExtrapolatedLengthInItsGuessedDirection) {
+  const Model model = testing::ModelFromToml(testing::SmallHelicesToml(1, 15, 600, "model = \"rss\""));
+  const RodModel& rod = model.rods[0];
+  const State state = MakeRestState(model);
+  VecX guess = state.q, before = state.q;
+  for (int i = 0; i < rod.num_nodes(); ++i) {  // stretched by 3 %, turned, shifted
+    Vec3 x = 1.03 * state.q.segment<3>(rod.dof_offset + NodeDof(i));
+    x = Vec3(x.x() - 0.05 * x.y(), x.y() + 0.05 * x.x(), x.z()) + Vec3(1e-3, 0.0, 0.0);
+    guess.segment<3>(rod.dof_offset + NodeDof(i)) = x;
+    before.segment<3>(rod.dof_offset + NodeDof(i)) *= 0.98;
+  }
+  for (int j = 0; j + 1 < rod.num_nodes(); ++j) guess(rod.dof_offset + NodeDof(j) + 3) += 0.1 * j;
+  const auto fixed = [&](int node) {
+    return std::binary_search(rod.fixed_dofs.begin(), rod.fixed_dofs.end(), NodeDof(node));
+  };
+  ASSERT_TRUE(fixed(0) && fixed(1) && !fixed(2));
+  const auto node = [&](const VecX& q, int k) { return Vec3(q.segment<3>(rod.dof_offset + NodeDof(k))); };
+  for (const double growth : {1.0, 1.02}) {
+    VecX kept = guess;
+    ExtrapolateEdgeLengths(model, state.q, growth == 1.0 ? nullptr : &before, &kept);
+    for (int i = 0; i < rod.num_nodes(); ++i) {
+      if (fixed(i)) EXPECT_EQ(node(kept, i), node(guess, i)) << i;
+      if (i == 0 || fixed(i)) continue;
+      const Vec3 edge = node(kept, i) - node(kept, i - 1);
+      const double length = (node(state.q, i) - node(state.q, i - 1)).norm();
+      EXPECT_NEAR(edge.norm(), growth * length, 1e-15) << i;
+      const Vec3 aim = node(guess, i) - node(kept, i - 1);
+      EXPECT_NEAR(edge.normalized().dot(aim.normalized()), 1.0, 1e-14) << i;
+    }
+    for (int j = 0; j + 1 < rod.num_nodes(); ++j)
+      EXPECT_EQ(kept(rod.dof_offset + NodeDof(j) + 3), guess(rod.dof_offset + NodeDof(j) + 3)) << j;
+  }
 }
 
 }  // namespace

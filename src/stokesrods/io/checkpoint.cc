@@ -14,7 +14,7 @@ namespace {
 constexpr char kMagic[8] = {'S', 'R', 'C', 'K', 'P', 'T', '\0', '\0'};
 // 4: the earlier drags; 5: the bodies' previous poses; 6: the dense 𝕄's reuse history; 7: its
 // skipped measurements; 8: the last row of the time series
-constexpr std::uint32_t kVersion = 8;
+constexpr std::uint32_t kVersion = 9;
 constexpr std::uint32_t kOldestVersion = 2;  // without the controls
 
 std::uint64_t Fnv1a(const char* data, std::size_t bytes, std::uint64_t hash = 14695981039346656037ull) {
@@ -171,6 +171,10 @@ void SaveCheckpoint(const std::string& path, const Model& model, const Checkpoin
   w.Put(static_cast<std::int64_t>(reuse.skip_length));
   w.Put(static_cast<std::int64_t>(c.last_row.size()));  // version 8
   w.Raw(c.last_row.data(), sizeof(double) * c.last_row.size());
+  w.Vector(c.history.older_velocity);  // version 9: the cubic predictor's history
+  w.Put(c.history.older_h);
+  w.Put(static_cast<std::int64_t>(c.history.cubic_predictor ? 1 : 0));
+  w.Put(c.history.damped_miss);
   w.Put(Fnv1a(w.text().data(), w.text().size()));
   WriteFileAtomically(path, w.text());
 }
@@ -266,6 +270,15 @@ Checkpoint LoadCheckpoint(const std::string& path, const Model& model) {
       r.Fail(fmt::format("a time-series row of {} values", count));
     c.last_row.resize(static_cast<std::size_t>(count));
     r.Raw(c.last_row.data(), sizeof(double) * c.last_row.size());
+  }
+  if (version >= 9) {  // the cubic predictor's history (sim/integrator.cc, Predict)
+    c.history.older_velocity = r.Vector(model.num_dofs, "the velocity before the previous", true);
+    c.history.older_h = r.Get<double>();
+    const auto cubic = r.Get<std::int64_t>();
+    if (cubic != 0 && cubic != 1) r.Fail(fmt::format("a predictor choice of {}", cubic));
+    c.history.cubic_predictor = cubic == 1;
+    c.history.damped_miss = r.Get<double>();
+    if (!(c.history.damped_miss >= 0.0)) r.Fail("a negative or undefined predictor miss");
   }
   if (r.at() + sizeof stored_sum != text.size()) r.Fail("unexpected data after the contents");
   return c;

@@ -27,6 +27,10 @@ StepHistory CaptureHistory(const Workspace& ws) {
   return {ws.previous_q,
           ws.previous_velocity,
           ws.previous_h,
+          ws.older_velocity,
+          ws.older_h,
+          ws.cubic_predictor,
+          ws.damped_miss,
           ws.nonlocal_fluid ? ws.hydro_force : VecX(),
           ws.earlier_drags,
           ws.previous_poses,
@@ -37,6 +41,10 @@ void RestoreHistory(const StepHistory& history, Workspace* ws) {
   ws->previous_q = history.previous_q;
   ws->previous_velocity = history.previous_velocity;
   ws->previous_h = history.previous_h;
+  ws->older_velocity = history.older_velocity;
+  ws->older_h = history.older_h;
+  ws->cubic_predictor = history.cubic_predictor;
+  ws->damped_miss = history.damped_miss;
   ws->previous_poses = history.previous_poses;
   if (ws->nonlocal_fluid) ws->hydro_force = history.hydro_force;
   ws->earlier_drags = history.earlier_drags;
@@ -49,12 +57,31 @@ void ForgetReuse(Workspace* ws) {
   ws->factors_h = -1.0;
   ws->factors_age = 0;
   ws->last_iterations = 0;
+  ws->last_clean = false;
   if (ws->nonlocal_fluid) ws->hydro.ForgetReuse(ws->hydro_force);
 }
 
 void DriveBoundaryConditions(const Model& model, double h, VecX* q) {
   for (const RodModel& rod : model.rods)
     if (rod.clamped_nodes >= 2) (*q)(rod.dof_offset + TwistDof(0)) += h * rod.twist_rate;
+}
+
+void ExtrapolateEdgeLengths(const Model& model, const VecX& q_start, const VecX* q_before,
+                            VecX* q) {
+  for (const RodModel& rod : model.rods) {
+    if (rod.body >= 0) continue;  // its first nodes go where its body puts them
+    for (int i = 0; i + 1 < rod.num_nodes(); ++i) {
+      if (std::binary_search(rod.fixed_dofs.begin(), rod.fixed_dofs.end(), NodeDof(i + 1)))
+        continue;  // a fixed node stays where the step drives it
+      const int a = rod.dof_offset + NodeDof(i), b = rod.dof_offset + NodeDof(i + 1);
+      double length = (q_start.segment<3>(b) - q_start.segment<3>(a)).norm();
+      if (q_before)
+        length += length - (q_before->segment<3>(b) - q_before->segment<3>(a)).norm();
+      const Vec3 edge = q->segment<3>(b) - q->segment<3>(a);
+      const double guessed = edge.norm();
+      if (guessed > 0.0) q->segment<3>(b) = q->segment<3>(a) + (length / guessed) * edge;
+    }
+  }
 }
 
 void Evaluate(const Model& model, const State& start, double h, const VecX& q,
@@ -159,12 +186,17 @@ StepReport StepOnce(const Model& model, double h, State* state, Workspace* ws);
 // A step whose extrapolated drag guess did not converge is tried once more from the drag f_k
 // itself, before the caller halves it: at large steps (BDF2 at 100 ms on the swimming cell) the
 // extrapolation can start Newton where it fails, and the plain guess does not.
+// Likewise a step whose Newton started from the cubic predictor is tried again from the damped
+// one (Predict), and the next steps start from the damped one until it misses by more.
 StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
   StepReport report = StepOnce(model, h, state, ws);
-  if (report.ok || !ws->drag_extrapolated) return report;
+  if (report.ok || (!ws->drag_extrapolated && !ws->used_cubic)) return report;
+  if (ws->used_cubic) ws->cubic_predictor = false;
   ws->extrapolate_drag = false;
+  ws->allow_cubic = false;
   StepReport retry = StepOnce(model, h, state, ws);
   ws->extrapolate_drag = true;
+  ws->allow_cubic = true;
   retry.newton_iterations += report.newton_iterations;
   retry.krylov_iterations += report.krylov_iterations;
   return retry;
@@ -172,17 +204,64 @@ StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
 
 namespace {
 
+// The step's two guesses of q(t_{k+1}) (Workspace::damped_guess, cubic_guess), with the fixed and
+// driven DOFs where the step puts them, and the one its Newton starts from in ws->q.
+//  - Damped: Algorithm 1's guess q_k + h q̇_k, plus ½h² q̈_k = ½h (q̇_k − q̇_{k−1}) once two
+//    velocities are known (rods that turn by a sizeable angle per step move on circles, which the
+//    linear guess misses). Robust at large steps, where the velocities of the stiff modes
+//    alternate from step to step; BDF2 takes its mobility and local drag there.
+//  - Cubic: q_k + h q̇_{k+1} with q̇_{k+1} = 3q̇_k − 3q̇_{k−1} + q̇_{k−2} (the velocities of three
+//    steps of the same h extrapolated quadratically; with implicit Euler's q̇ = Δq/h, the cubic
+//    through q_{k−3} … q_k). Where the motion is smooth it is far closer: on paper Fig. 1 the
+//    first Newton correction 2.6e-7 → 1.2e-10 m at h = 1 ms, and at 10 ms Newton 3.0 → 1.02
+//    iterations per step. For implicit Euler only: BDF2's q̇ is not Δq/h, and at its 20 and
+//    40 ms steps the same extrapolation is farther and Newton takes twice the iterations or fails
+//    (docs/performance.md, session 32).
+// Newton starts from the cubic one where it came closer to the last step's solution than the
+// damped one (Workspace::cubic_predictor, set in StepOnce after each step), unless the two now
+// differ by more than four times the damped one's last miss (the motion changed: a contact, a
+// drive that starts); a step that fails from it is tried again from the damped one (Step).
+void Predict(const Model& model, double h, const State& state, Workspace* ws) {
+  const auto place = [&](VecX* q) {
+    for (const RodModel& rod : model.rods)
+      for (int k : rod.fixed_dofs) (*q)(rod.dof_offset + k) = state.q(rod.dof_offset + k);
+    DriveBoundaryConditions(model, h, q);
+  };
+  const auto n = state.velocity.size();
+  const bool have_previous = ws->previous_velocity.size() == n;
+  ws->damped_guess = state.q + h * state.velocity;
+  if (have_previous) ws->damped_guess += 0.5 * h * (state.velocity - ws->previous_velocity);
+  place(&ws->damped_guess);
+  ws->cubic_guess.resize(0);
+  if (model.integrator == TimeIntegrator::kEuler && have_previous &&
+      ws->older_velocity.size() == n && ws->previous_h == h && ws->older_h == h) {
+    ws->cubic_guess =
+        state.q + h * (3.0 * state.velocity - 3.0 * ws->previous_velocity + ws->older_velocity);
+    place(&ws->cubic_guess);
+  }
+  ws->used_cubic = ws->allow_cubic && ws->cubic_predictor && ws->cubic_guess.size() == n &&
+                   CorrectionNorm(model, ws->cubic_guess - ws->damped_guess) <= 4.0 * ws->damped_miss;
+  ws->q = ws->used_cubic ? ws->cubic_guess : ws->damped_guess;
+}
+
+// After a step to q(t_{k+1}): which guess came closer (in CorrectionNorm's metres), for the next.
+// The cubic one only where the damped one missed by more than Newton's smallest correction
+// (1e-10 of the rod length, sim/newton.cc: conditioning allows no better): below that there is
+// nothing to extrapolate but rounding, which the cubic's weights (3, −3, 1 on q̇) amplify, and
+// the solution accepts within its tolerance (a helix at rest drifted 4e-12 m in 1000 steps
+// instead of less than 1e-12: tests/validation, RestHelix).
+void ChoosePredictor(const Model& model, const VecX& q, Workspace* ws) {
+  ws->damped_miss = CorrectionNorm(model, q - ws->damped_guess);
+  ws->cubic_predictor = ws->cubic_guess.size() == q.size() &&
+                        ws->damped_miss > 1e-10 * model.length_scale &&
+                        CorrectionNorm(model, q - ws->cubic_guess) < ws->damped_miss;
+}
+
 StepReport StepOnce(const Model& model, double h, State* state, Workspace* ws) {
   StepReport report;
-  // Algorithm 1's guess q_k + h q̇_k, plus ½h² q̈_k once two velocities are known: rods that
-  // turn by a sizeable angle per step move on circles, which the linear guess misses. Contact
-  // rounds after the first start from the previous round's solution.
-  ws->q = state->q + h * state->velocity;
+  // Contact rounds after the first start from the previous round's solution.
+  Predict(model, h, *state, ws);
   const bool have_previous = ws->previous_velocity.size() == state->velocity.size();
-  if (have_previous) ws->q += 0.5 * h * (state->velocity - ws->previous_velocity);
-  for (const RodModel& rod : model.rods)
-    for (int k : rod.fixed_dofs) ws->q(rod.dof_offset + k) = state->q(rod.dof_offset + k);
-  DriveBoundaryConditions(model, h, &ws->q);
   const bool implicit_drag = ws->nonlocal_fluid && model.coupling != FluidCoupling::kExplicit;
   if (implicit_drag) PredictDrag(h, ws);
 
@@ -232,7 +311,7 @@ StepReport StepOnce(const Model& model, double h, State* state, Workspace* ws) {
   } give_back{&start, state};
   if (bdf2) {
     State& geometry = ws->step_geometry;  // where the step's mobility and local drag are taken
-    geometry.q = ws->q;
+    geometry.q = ws->q;  // the damped guess (BDF2 takes no other), clamps on bodies placed
     geometry.velocity = state->velocity;
     geometry.time = state->time + h;  // the predictor's time: the bodies' (known) poses there
     geometry.bodies = ws->body_step.geometry;
@@ -243,6 +322,15 @@ StepReport StepOnce(const Model& model, double h, State* state, Workspace* ws) {
 
   // Clamps on free bodies where the first guess's V puts them (Φ(V), as every Newton trial does).
   if (ws->free_clamps) PlaceFreeClamps(model, ws->body_step, ws->hydro_force, &ws->q);
+  // Newton starts from the guess with each edge at its extrapolated length
+  // (ExtrapolateEdgeLengths); the two guesses likewise, as ChoosePredictor compares them. After
+  // every placement: BDF2 takes its geometry at the guess as predicted.
+  const VecX* before =
+      ws->previous_q.size() == state->q.size() && ws->previous_h == h ? &ws->previous_q : nullptr;
+  ExtrapolateEdgeLengths(model, state->q, before, &ws->q);
+  ExtrapolateEdgeLengths(model, state->q, before, &ws->damped_guess);
+  if (ws->cubic_guess.size() == state->q.size())
+    ExtrapolateEdgeLengths(model, state->q, before, &ws->cubic_guess);
   if (ws->nonlocal_fluid) ws->hydro.ResetSolveReport();
   for (report.contact_rounds = 1;; ++report.contact_rounds) {
     const NewtonReport newton = SolveNewton(model, start, he, ws);
@@ -300,6 +388,9 @@ StepReport StepOnce(const Model& model, double h, State* state, Workspace* ws) {
     }
   }
   if (implicit_drag) RememberDrag(h, ws);
+  ChoosePredictor(model, ws->q, ws);
+  std::swap(ws->older_velocity, ws->previous_velocity);
+  ws->older_h = ws->previous_h;
   ws->previous_velocity = state->velocity;
   ws->previous_q = state->q;
   ws->previous_h = h;

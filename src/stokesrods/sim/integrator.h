@@ -74,9 +74,18 @@ struct Workspace {
   /// The loads on the free bodies (force, torque about the centre; 6 each), constant in a Newton
   /// solve: their own (BodyModel::force, torque) and the contacts' reactions.
   VecX body_load;
-  VecX previous_velocity;        ///< q̇(t_{k−1}), for the second-order predictor and BDF2
+  VecX previous_velocity;        ///< q̇(t_{k−1}), for the predictors and BDF2
   VecX previous_q;               ///< q(t_{k−1}), for BDF2
   double previous_h = 0.0;       ///< the step that led to t_k
+  VecX older_velocity;           ///< q̇(t_{k−2}), for the cubic predictor (empty when unknown)
+  double older_h = 0.0;          ///< the step that led to t_{k−1}
+  /// The cubic predictor came closer to the last step's solution than the damped one (Predict):
+  /// this step's Newton starts from it.
+  bool cubic_predictor = false;
+  double damped_miss = 0.0;      ///< how far the damped predictor missed the last step [m]
+  VecX damped_guess, cubic_guess;  ///< this step's two predictors (the second empty if unknown)
+  bool used_cubic = false;       ///< this step's Newton started from the cubic predictor
+  bool allow_cubic = true;       ///< off while a failed step is retried from the damped one (Step)
   /// The implicit drag at t_{k−1} and t_{k−2}, of steps of size previous_h (empty when unknown):
   /// the next step's first guess extrapolates the drag through them (PredictDrag).
   std::array<VecX, 2> earlier_drags;
@@ -94,6 +103,9 @@ struct Workspace {
   double factors_h = -1.0;       ///< the step size they were built for (0: static)
   int factors_age = 0;           ///< steps since they were built
   int last_iterations = 0;       ///< Newton iterations of the last converged solve
+  /// The last converged solve took one full step that met the tolerance (no simplified
+  /// correction): its factors may serve the next step (SolveNewton).
+  bool last_clean = false;
 };
 
 /// What the next step reads from the steps before it, besides the State: BDF2's history and the
@@ -102,6 +114,10 @@ struct StepHistory {
   VecX previous_q;          ///< q(t_{k−1}) (empty before the first step)
   VecX previous_velocity;   ///< q̇(t_{k−1})
   double previous_h = 0.0;  ///< [s]
+  VecX older_velocity;      ///< q̇(t_{k−2}) (empty when unknown)
+  double older_h = 0.0;     ///< [s]
+  bool cubic_predictor = false;  ///< the predictor of the next step (Workspace)
+  double damped_miss = 0.0;      ///< [m] (Workspace)
   VecX hydro_force;         ///< the nodal drag of the last step (3M; empty without a nonlocal fluid)
   std::array<VecX, 2> earlier_drags;  ///< the drag at t_{k−1}, t_{k−2} (Workspace)
   std::vector<BodyPose> previous_poses;  ///< the bodies at t_{k−1} (empty before the first step)
@@ -117,6 +133,19 @@ void RestoreHistory(const StepHistory& history, Workspace* ws);
 /// dense 𝕄's reuse is not forgotten: its history is in the StepHistory, and RestoreHistory
 /// assembles its matrices again.
 void ForgetReuse(Workspace* ws);
+
+/// The predictor's guess q(t_{k+1}) with each edge of a rod at its length extrapolated linearly
+/// from q_before (q_{k−1}, of a step of the same h) and q_start (q_k): 2|e_k| − |e_{k−1}|, or
+/// |e_k| without q_before. Walked from the rod's first node: each edge from its first node (as
+/// placed) towards its second node's guessed position; a fixed node left where the step drives
+/// it (the next edge starts there); twist angles as guessed; rods clamped on bodies as they are.
+/// A polynomial through node positions that turn by a sizeable angle per step changes the
+/// edges' chords, and the stretching residual that makes (EA ≫ EI/L²) is most of what Newton then
+/// undoes. The lengths are extrapolated, not kept: the edges do stretch in time, and at small
+/// steps setting them back to |e_k| moved a close guess by more than it missed (on paper Fig. 1
+/// at h = 1 ms, kept Newton factors then took 1.5 iterations per step instead of 1.0).
+void ExtrapolateEdgeLengths(const Model& model, const VecX& q_start, const VecX* q_before,
+                            VecX* q);
 
 /// What depends on the start of a step only: the local forces' caches, the mobility 𝕄 at q_k (and
 /// the explicit drag), the contact force reset. Step calls it; Evaluate needs it first.

@@ -61,7 +61,8 @@ double RoundOffFloor(const Model& model, const VecX& q) {
   return floor;
 }
 
-// Size of a correction in metres: positions as they are, twist angles times their edge length.
+}  // namespace
+
 double CorrectionNorm(const Model& model, const VecX& delta) {
   double sum = 0.0;
   for (const RodModel& rod : model.rods)
@@ -71,8 +72,6 @@ double CorrectionNorm(const Model& model, const VecX& delta) {
     }
   return std::sqrt(sum);
 }
-
-}  // namespace
 
 std::string DescribeResidual(const Model& model, const VecX& r) {
   std::size_t worst_rod = 0;
@@ -149,8 +148,11 @@ NewtonReport SolveNewton(const Model& model, const State& start, double h, Works
   const double step_tolerance = 1e-10 * model.length_scale;
   // Old factors are worth keeping while they converge a step in a few iterations; a step that
   // needed more (a rod turning fast, a contact) rebuilds them at the start of the next.
+  // In time steps kept only after a clean step (one full Newton step that met the tolerance): a
+  // step that needed more was too far from its guess for old factors to take it in one.
+  const bool last_poor = h > 0.0 ? !ws->last_clean : ws->last_iterations > 3;
   bool fresh = !ws->factors_valid || ws->factors_h != h ||
-               ws->factors_age >= model.newton.jacobian_max_age || ws->last_iterations > 3 ||
+               ws->factors_age >= model.newton.jacobian_max_age || last_poor ||
                (saddle && ws->hydro.wants_refresh());
   Evaluate(model, start, h, ws->q, ws->hydro_force, fresh, ws, &ws->frames, &ws->residual);
   if (fresh) ws->factors_valid = false;  // ws->jacobian now holds an unfactorized assembly
@@ -175,12 +177,14 @@ NewtonReport SolveNewton(const Model& model, const State& start, double h, Works
   bool have_correction = false;  // ws->delta already holds the correction at ws->q
   double norm = norm_of(ws->residual, ws->velocity_residual);
   bool small_correction = false;
+  bool simplified_solved = false;  // a simplified correction was needed
   for (report.iterations = 0;; ++report.iterations) {
     report.tolerance = tolerance_at(ws->q);
     report.residual = norm;
     if (norm <= report.tolerance || small_correction) {
       report.converged = true;
       ws->last_iterations = report.iterations;
+      ws->last_clean = report.iterations <= 1 && !simplified_solved;
       return report;
     }
     if (report.iterations == model.newton.max_iterations) return report;
@@ -226,6 +230,7 @@ NewtonReport SolveNewton(const Model& model, const State& start, double h, Works
         if (saddle) ws->simplified_hydro_delta.setZero(), ws->simplified_hydro_rate.setZero();
         break;
       }
+      simplified_solved = true;
       report.krylov_iterations += NewtonCorrection(
           model, h, ws->residual_try, ws->velocity_residual_try, ws, &ws->simplified,
           &ws->simplified_hydro_delta, &ws->simplified_hydro_rate, velocity_tolerance);

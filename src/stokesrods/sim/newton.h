@@ -31,6 +31,9 @@ NewtonReport SolveNewton(const Model& model, const State& start, double h, Works
 
 /// Where a residual is largest, or first not finite: "largest at rod 2, node 14 (a force)".
 std::string DescribeResidual(const Model& model, const VecX& r);
+/// Size of a correction (or any difference of q) in metres: positions as they are, twist angles
+/// times their edge length.
+double CorrectionNorm(const Model& model, const VecX& delta);
 
 /// How the iterations went, when that points to a remedy (damped iterations, a last iteration
 /// still converging fast); empty otherwise.
