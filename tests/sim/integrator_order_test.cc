@@ -51,7 +51,8 @@ TEST(IntegratorOrder, Bdf2IsSecondOrder) {
   EXPECT_NEAR(p[1], 2.0, 0.3);
 }
 
-// The predictor's guess with its edges at their extrapolated lengths (ExtrapolateEdgeLengths):
+// The predictor's guess with its edges at their extrapolated lengths (ExtrapolateEdgeLengths,
+// SetEdgeLengths):
 // on a helix clamped at its first two nodes, a guess stretched, turned and with its fixed nodes
 // and twists moved by the step. Every free edge takes the length 2|e_k| − |e_{k−1}| (q_{k−1}
 // shrunk by 2 % about the origin, so 1.02 |e_k|), or |e_k| without q_{k−1}, and points from its
@@ -75,8 +76,9 @@ TEST(Predictor, SetsEachEdgeToItsExtrapolatedLengthInItsGuessedDirection) {
   ASSERT_TRUE(fixed(0) && fixed(1) && !fixed(2));
   const auto node = [&](const VecX& q, int k) { return Vec3(q.segment<3>(rod.dof_offset + NodeDof(k))); };
   for (const double growth : {1.0, 1.02}) {
-    VecX kept = guess;
-    ExtrapolateEdgeLengths(model, state.q, growth == 1.0 ? nullptr : &before, &kept);
+    VecX kept = guess, lengths;
+    ExtrapolateEdgeLengths(model, state.q, growth == 1.0 ? nullptr : &before, &lengths);
+    SetEdgeLengths(model, lengths, &kept);
     for (int i = 0; i < rod.num_nodes(); ++i) {
       if (fixed(i)) EXPECT_EQ(node(kept, i), node(guess, i)) << i;
       if (i == 0 || fixed(i)) continue;

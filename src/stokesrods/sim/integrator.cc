@@ -58,6 +58,7 @@ void ForgetReuse(Workspace* ws) {
   ws->factors_age = 0;
   ws->last_iterations = 0;
   ws->last_clean = false;
+  ws->reuse_wait = ws->reuse_backoff = 0;
   if (ws->nonlocal_fluid) ws->hydro.ForgetReuse(ws->hydro_force);
 }
 
@@ -67,19 +68,31 @@ void DriveBoundaryConditions(const Model& model, double h, VecX* q) {
 }
 
 void ExtrapolateEdgeLengths(const Model& model, const VecX& q_start, const VecX* q_before,
-                            VecX* q) {
-  for (const RodModel& rod : model.rods) {
-    if (rod.body >= 0) continue;  // its first nodes go where its body puts them
+                            VecX* lengths) {
+  lengths->resize(model.num_nodes);
+  for (const RodModel& rod : model.rods)
     for (int i = 0; i + 1 < rod.num_nodes(); ++i) {
-      if (std::binary_search(rod.fixed_dofs.begin(), rod.fixed_dofs.end(), NodeDof(i + 1)))
-        continue;  // a fixed node stays where the step drives it
       const int a = rod.dof_offset + NodeDof(i), b = rod.dof_offset + NodeDof(i + 1);
       double length = (q_start.segment<3>(b) - q_start.segment<3>(a)).norm();
       if (q_before)
         length += length - (q_before->segment<3>(b) - q_before->segment<3>(a)).norm();
+      (*lengths)(rod.node_offset + i) = length;
+    }
+}
+
+void SetEdgeLengths(const Model& model, const VecX& lengths, VecX* q) {
+  for (const RodModel& rod : model.rods) {
+    if (rod.body >= 0) continue;  // its first nodes go where its body puts them
+    auto fixed = rod.fixed_dofs.begin();  // sorted
+    for (int i = 0; i + 1 < rod.num_nodes(); ++i) {
+      while (fixed != rod.fixed_dofs.end() && *fixed < NodeDof(i + 1)) ++fixed;
+      if (fixed != rod.fixed_dofs.end() && *fixed == NodeDof(i + 1))
+        continue;  // a fixed node stays where the step drives it
+      const int a = rod.dof_offset + NodeDof(i), b = rod.dof_offset + NodeDof(i + 1);
       const Vec3 edge = q->segment<3>(b) - q->segment<3>(a);
       const double guessed = edge.norm();
-      if (guessed > 0.0) q->segment<3>(b) = q->segment<3>(a) + (length / guessed) * edge;
+      if (guessed > 0.0)
+        q->segment<3>(b) = q->segment<3>(a) + (lengths(rod.node_offset + i) / guessed) * edge;
     }
   }
 }
@@ -213,10 +226,11 @@ namespace {
 //  - Cubic: q_k + h q̇_{k+1} with q̇_{k+1} = 3q̇_k − 3q̇_{k−1} + q̇_{k−2} (the velocities of three
 //    steps of the same h extrapolated quadratically; with implicit Euler's q̇ = Δq/h, the cubic
 //    through q_{k−3} … q_k). Where the motion is smooth it is far closer: on paper Fig. 1 the
-//    first Newton correction 2.6e-7 → 1.2e-10 m at h = 1 ms, and at 10 ms Newton 3.0 → 1.02
-//    iterations per step. For implicit Euler only: BDF2's q̇ is not Δq/h, and at its 20 and
-//    40 ms steps the same extrapolation is farther and Newton takes twice the iterations or fails
-//    (docs/performance.md, session 32).
+//    first Newton correction 2.6e-7 → 1.2e-10 m at h = 1 ms, and at 10 ms (with the edges'
+//    lengths set, StepOnce) Newton 3.0 → 1.1 iterations and GMRES 7.0 → 3.0 products per step.
+//    For implicit Euler only: BDF2's q̇ is not Δq/h, and at its 20 and 40 ms steps the same
+//    extrapolation is farther and Newton takes twice the iterations or fails (docs/
+//    performance.md, sessions 32 and 33).
 // Newton starts from the cubic one where it came closer to the last step's solution than the
 // damped one (Workspace::cubic_predictor, set in StepOnce after each step), unless the two now
 // differ by more than four times the damped one's last miss (the motion changed: a contact, a
@@ -232,15 +246,16 @@ void Predict(const Model& model, double h, const State& state, Workspace* ws) {
   ws->damped_guess = state.q + h * state.velocity;
   if (have_previous) ws->damped_guess += 0.5 * h * (state.velocity - ws->previous_velocity);
   place(&ws->damped_guess);
-  ws->cubic_guess.resize(0);
-  if (model.integrator == TimeIntegrator::kEuler && have_previous &&
-      ws->older_velocity.size() == n && ws->previous_h == h && ws->older_h == h) {
+  ws->have_cubic_guess = model.integrator == TimeIntegrator::kEuler && have_previous &&
+      ws->older_velocity.size() == n && ws->previous_h == h && ws->older_h == h;
+  if (ws->have_cubic_guess) {
     ws->cubic_guess =
         state.q + h * (3.0 * state.velocity - 3.0 * ws->previous_velocity + ws->older_velocity);
     place(&ws->cubic_guess);
   }
-  ws->used_cubic = ws->allow_cubic && ws->cubic_predictor && ws->cubic_guess.size() == n &&
-                   CorrectionNorm(model, ws->cubic_guess - ws->damped_guess) <= 4.0 * ws->damped_miss;
+  ws->used_cubic =
+      ws->allow_cubic && ws->cubic_predictor && ws->have_cubic_guess &&
+      CorrectionDistance(model, ws->cubic_guess, ws->damped_guess) <= 4.0 * ws->damped_miss;
   ws->q = ws->used_cubic ? ws->cubic_guess : ws->damped_guess;
 }
 
@@ -251,10 +266,10 @@ void Predict(const Model& model, double h, const State& state, Workspace* ws) {
 // the solution accepts within its tolerance (a helix at rest drifted 4e-12 m in 1000 steps
 // instead of less than 1e-12: tests/validation, RestHelix).
 void ChoosePredictor(const Model& model, const VecX& q, Workspace* ws) {
-  ws->damped_miss = CorrectionNorm(model, q - ws->damped_guess);
-  ws->cubic_predictor = ws->cubic_guess.size() == q.size() &&
+  ws->damped_miss = CorrectionDistance(model, q, ws->damped_guess);
+  ws->cubic_predictor = ws->have_cubic_guess &&
                         ws->damped_miss > 1e-10 * model.length_scale &&
-                        CorrectionNorm(model, q - ws->cubic_guess) < ws->damped_miss;
+                        CorrectionDistance(model, q, ws->cubic_guess) < ws->damped_miss;
 }
 
 StepReport StepOnce(const Model& model, double h, State* state, Workspace* ws) {
@@ -322,15 +337,14 @@ StepReport StepOnce(const Model& model, double h, State* state, Workspace* ws) {
 
   // Clamps on free bodies where the first guess's V puts them (Φ(V), as every Newton trial does).
   if (ws->free_clamps) PlaceFreeClamps(model, ws->body_step, ws->hydro_force, &ws->q);
-  // Newton starts from the guess with each edge at its extrapolated length
-  // (ExtrapolateEdgeLengths); the two guesses likewise, as ChoosePredictor compares them. After
-  // every placement: BDF2 takes its geometry at the guess as predicted.
+  // Newton starts from the guess with each edge at its extrapolated length (SetEdgeLengths). After
+  // every placement: BDF2 takes its geometry at the guess as predicted. ChoosePredictor compares
+  // the two guesses as extrapolated (setting the lengths on all three made the same choices on
+  // paper Fig. 1 at 1 and 10 ms and on the regression case, at three times the cost).
   const VecX* before =
       ws->previous_q.size() == state->q.size() && ws->previous_h == h ? &ws->previous_q : nullptr;
-  ExtrapolateEdgeLengths(model, state->q, before, &ws->q);
-  ExtrapolateEdgeLengths(model, state->q, before, &ws->damped_guess);
-  if (ws->cubic_guess.size() == state->q.size())
-    ExtrapolateEdgeLengths(model, state->q, before, &ws->cubic_guess);
+  ExtrapolateEdgeLengths(model, state->q, before, &ws->edge_lengths);
+  SetEdgeLengths(model, ws->edge_lengths, &ws->q);
   if (ws->nonlocal_fluid) ws->hydro.ResetSolveReport();
   for (report.contact_rounds = 1;; ++report.contact_rounds) {
     const NewtonReport newton = SolveNewton(model, start, he, ws);

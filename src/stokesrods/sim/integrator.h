@@ -83,7 +83,9 @@ struct Workspace {
   /// this step's Newton starts from it.
   bool cubic_predictor = false;
   double damped_miss = 0.0;      ///< how far the damped predictor missed the last step [m]
-  VecX damped_guess, cubic_guess;  ///< this step's two predictors (the second empty if unknown)
+  VecX damped_guess, cubic_guess;  ///< this step's two predictors
+  bool have_cubic_guess = false;   ///< cubic_guess is this step's (implicit Euler, history known)
+  VecX edge_lengths;               ///< the guesses' edge lengths (ExtrapolateEdgeLengths)
   bool used_cubic = false;       ///< this step's Newton started from the cubic predictor
   bool allow_cubic = true;       ///< off while a failed step is retried from the damped one (Step)
   /// The implicit drag at t_{k−1} and t_{k−2}, of steps of size previous_h (empty when unknown):
@@ -106,6 +108,10 @@ struct Workspace {
   /// The last converged solve took one full step that met the tolerance (no simplified
   /// correction): its factors may serve the next step (SolveNewton).
   bool last_clean = false;
+  /// Steps before kept factors may serve again, after steps that kept them and were not clean
+  /// (SolveNewton), and the wait after the last such step (doubled by each, cleared by a clean one).
+  int reuse_wait = 0;
+  int reuse_backoff = 0;
 };
 
 /// What the next step reads from the steps before it, besides the State: BDF2's history and the
@@ -134,18 +140,22 @@ void RestoreHistory(const StepHistory& history, Workspace* ws);
 /// assembles its matrices again.
 void ForgetReuse(Workspace* ws);
 
-/// The predictor's guess q(t_{k+1}) with each edge of a rod at its length extrapolated linearly
-/// from q_before (q_{k−1}, of a step of the same h) and q_start (q_k): 2|e_k| − |e_{k−1}|, or
-/// |e_k| without q_before. Walked from the rod's first node: each edge from its first node (as
-/// placed) towards its second node's guessed position; a fixed node left where the step drives
-/// it (the next edge starts there); twist angles as guessed; rods clamped on bodies as they are.
+/// The lengths the predictor's guess q(t_{k+1}) gives each edge (SetEdgeLengths), extrapolated
+/// linearly from q_before (q_{k−1}, of a step of the same h) and q_start (q_k): 2|e_k| − |e_{k−1}|,
+/// or |e_k| without q_before; edge i of a rod at rod.node_offset + i of `lengths` (num_nodes).
 /// A polynomial through node positions that turn by a sizeable angle per step changes the
 /// edges' chords, and the stretching residual that makes (EA ≫ EI/L²) is most of what Newton then
 /// undoes. The lengths are extrapolated, not kept: the edges do stretch in time, and at small
 /// steps setting them back to |e_k| moved a close guess by more than it missed (on paper Fig. 1
 /// at h = 1 ms, kept Newton factors then took 1.5 iterations per step instead of 1.0).
 void ExtrapolateEdgeLengths(const Model& model, const VecX& q_start, const VecX* q_before,
-                            VecX* q);
+                            VecX* lengths);
+
+/// Each edge of the guess q set to its length in `lengths` (ExtrapolateEdgeLengths), walked from
+/// the rod's first node: each edge from its first node (as placed) towards its second node's
+/// guessed position; a fixed node left where the step drives it (the next edge starts there);
+/// twist angles as guessed; rods clamped on bodies as they are.
+void SetEdgeLengths(const Model& model, const VecX& lengths, VecX* q);
 
 /// What depends on the start of a step only: the local forces' caches, the mobility 𝕄 at q_k (and
 /// the explicit drag), the contact force reset. Step calls it; Evaluate needs it first.

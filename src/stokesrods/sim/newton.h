@@ -34,6 +34,8 @@ std::string DescribeResidual(const Model& model, const VecX& r);
 /// Size of a correction (or any difference of q) in metres: positions as they are, twist angles
 /// times their edge length.
 double CorrectionNorm(const Model& model, const VecX& delta);
+/// CorrectionNorm(a − b) without forming the difference.
+double CorrectionDistance(const Model& model, const VecX& a, const VecX& b);
 
 /// How the iterations went, when that points to a remedy (damped iterations, a last iteration
 /// still converging fast); empty otherwise.
