@@ -85,7 +85,7 @@ struct Workspace {
   double damped_miss = 0.0;      ///< how far the damped predictor missed the last step [m]
   VecX damped_guess, cubic_guess;  ///< this step's two predictors
   bool have_cubic_guess = false;   ///< cubic_guess is this step's (implicit Euler, history known)
-  VecX edge_lengths;               ///< the guesses' edge lengths (ExtrapolateEdgeLengths)
+  VecX edge_lengths;               ///< the lengths Newton's first guess gets (ExtrapolateEdgeLengths)
   bool used_cubic = false;       ///< this step's Newton started from the cubic predictor
   bool allow_cubic = true;       ///< off while a failed step is retried from the damped one (Step)
   /// The implicit drag at t_{k−1} and t_{k−2}, of steps of size previous_h (empty when unknown):
