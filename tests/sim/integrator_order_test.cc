@@ -52,9 +52,8 @@ TEST(IntegratorOrder, Bdf2IsSecondOrder) {
 }
 
 // The predictor's guess with its edges at their extrapolated lengths (ExtrapolateEdgeLengths,
-// SetEdgeLengths):
-// on a helix clamped at its first two nodes, a guess stretched, turned and with its fixed nodes
-// and twists moved by the step. Every free edge takes the length 2|e_k| − |e_{k−1}| (q_{k−1}
+// SetEdgeLengths): on a helix clamped at its first two nodes, a guess stretched, turned and with
+// its fixed nodes and twists moved by the step. Every free edge takes the length 2|e_k| − |e_{k−1}| (q_{k−1}
 // shrunk by 2 % about the origin, so 1.02 |e_k|), or |e_k| without q_{k−1}, and points from its
 // first node (as placed) at its second node's guessed position; the fixed nodes' positions and
 // all twist angles stay as guessed.

@@ -204,12 +204,10 @@ StepReport StepOnce(const Model& model, double h, State* state, Workspace* ws);
 StepReport Step(const Model& model, double h, State* state, Workspace* ws) {
   StepReport report = StepOnce(model, h, state, ws);
   if (report.ok || (!ws->drag_extrapolated && !ws->used_cubic)) return report;
-  if (ws->used_cubic) ws->cubic_predictor = false;
+  ws->cubic_predictor = false;  // the retry starts from the damped guess
   ws->extrapolate_drag = false;
-  ws->allow_cubic = false;
   StepReport retry = StepOnce(model, h, state, ws);
   ws->extrapolate_drag = true;
-  ws->allow_cubic = true;
   retry.newton_iterations += report.newton_iterations;
   retry.krylov_iterations += report.krylov_iterations;
   return retry;
@@ -254,7 +252,7 @@ void Predict(const Model& model, double h, const State& state, Workspace* ws) {
     place(&ws->cubic_guess);
   }
   ws->used_cubic =
-      ws->allow_cubic && ws->cubic_predictor && ws->have_cubic_guess &&
+      ws->cubic_predictor && ws->have_cubic_guess &&
       CorrectionDistance(model, ws->cubic_guess, ws->damped_guess) <= 4.0 * ws->damped_miss;
   ws->q = ws->used_cubic ? ws->cubic_guess : ws->damped_guess;
 }

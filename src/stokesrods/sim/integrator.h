@@ -87,7 +87,6 @@ struct Workspace {
   bool have_cubic_guess = false;   ///< cubic_guess is this step's (implicit Euler, history known)
   VecX edge_lengths;               ///< the lengths Newton's first guess gets (ExtrapolateEdgeLengths)
   bool used_cubic = false;       ///< this step's Newton started from the cubic predictor
-  bool allow_cubic = true;       ///< off while a failed step is retried from the damped one (Step)
   /// The implicit drag at t_{k−1} and t_{k−2}, of steps of size previous_h (empty when unknown):
   /// the next step's first guess extrapolates the drag through them (PredictDrag).
   std::array<VecX, 2> earlier_drags;

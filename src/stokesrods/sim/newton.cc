@@ -61,9 +61,10 @@ double RoundOffFloor(const Model& model, const VecX& q) {
   return floor;
 }
 
-}  // namespace
-
-double CorrectionNorm(const Model& model, const VecX& delta) {
+// Σ over the DOFs of (w d_i)², w = 1 on positions and |ē^j| on twist angles, of the difference
+// d_i = delta(i): CorrectionNorm's and CorrectionDistance's one loop.
+template <class Difference>
+double WeightedNorm(const Model& model, const Difference& delta) {
   double sum = 0.0;
   for (const RodModel& rod : model.rods)
     for (int k = 0; k < rod.num_dofs(); ++k) {
@@ -73,15 +74,14 @@ double CorrectionNorm(const Model& model, const VecX& delta) {
   return std::sqrt(sum);
 }
 
+}  // namespace
+
+double CorrectionNorm(const Model& model, const VecX& delta) {
+  return WeightedNorm(model, [&](int i) { return delta(i); });
+}
+
 double CorrectionDistance(const Model& model, const VecX& a, const VecX& b) {
-  double sum = 0.0;
-  for (const RodModel& rod : model.rods)
-    for (int k = 0; k < rod.num_dofs(); ++k) {
-      double d = a(rod.dof_offset + k) - b(rod.dof_offset + k);
-      if (k % 4 == 3) d *= rod.rest_edge_length(k / 4);
-      sum += d * d;
-    }
-  return std::sqrt(sum);
+  return WeightedNorm(model, [&](int i) { return a(i) - b(i); });
 }
 
 std::string DescribeResidual(const Model& model, const VecX& r) {
