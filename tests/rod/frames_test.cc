@@ -4,7 +4,9 @@
 
 #include <Eigen/LU>  // determinant
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "stokesrods/rod/geometry.h"
@@ -185,6 +187,79 @@ TEST(ReferenceTwist, PicksTheBranchClosestToPrevious) {
     twist = ReferenceTwist(f0, t, frame_at(angle), t, twist);
     ASSERT_NEAR(twist, angle, 1e-12);
   }
+}
+
+// The lanes' pass (rod/frame_lanes.h: AVX-512, AVX2) against the portable one, the reference
+// (TransportFramesInTime, then ReferenceTwists), on every path this CPU has (a path it lacks
+// runs the next narrower, so each call is still checked): helices of 4 … 65 nodes (every count of
+// spare lanes), moved by random steps of up to a fifth of an edge, with frames turned by up to π
+// about their tangents and previous twists wound several times. Tolerances: frames and tangents
+// 4e-15 (a few roundings of unit vectors); twists 4e-15 + 1e-15 |twist| (glibc's vector
+// arctangent is within a few units in the last place of std::atan2, and the unwinding adds
+// multiples of 2π).
+TEST(FramesTest, TransportFramesAndTwistsOnEachPath) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  double worst_frame = 0.0, worst_twist = 0.0;
+  for (FramePath path : {FramePath::kWidest, FramePath::kAvx2, FramePath::kPortable}) {
+    for (int nodes : {4, 5, 6, 7, 8, 9, 10, 11, 12, 17, 33, 65}) {
+      HelixGeometry g;
+      g.nodes = nodes;
+      const Matrix3X x = HelixNodes(g);
+      const double edge = (x.col(1) - x.col(0)).norm();
+      std::vector<RefFrame> frames = SpaceParallelFrames(x);
+      std::vector<Vec3> tangents = EdgeTangents(x);
+      for (std::size_t j = 0; j < frames.size(); ++j) {  // frames turned about their tangents
+        const double a = kPi * uniform(rng);
+        frames[j].d1 = Rotate(frames[j].d1, tangents[j], a);
+        frames[j].d2 = Rotate(frames[j].d2, tangents[j], a);
+      }
+      VecX previous(nodes);
+      for (int i = 0; i < nodes; ++i) previous[i] = 20.0 * uniform(rng);
+      Matrix3X x_new = x;
+      for (Eigen::Index i = 0; i < x.cols(); ++i)
+        x_new.col(i) += 0.2 * edge * Vec3(uniform(rng), uniform(rng), uniform(rng));
+      std::vector<RefFrame> frames_ref = frames, frames_lanes = frames;
+      std::vector<Vec3> tangents_ref = tangents, tangents_lanes = tangents;
+      TransportFramesInTime(x_new, &tangents_ref, &frames_ref);
+      const VecX twist_ref = ReferenceTwists(frames_ref, tangents_ref, previous);
+      VecX twist;
+      TransportFramesAndTwists(x_new, &tangents_lanes, &frames_lanes, previous, &twist, path);
+      ASSERT_EQ(twist.size(), nodes);
+      EXPECT_EQ(twist[0], 0.0);
+      EXPECT_EQ(twist[nodes - 1], 0.0);
+      for (std::size_t j = 0; j < frames.size(); ++j) {
+        const double e = std::max({(frames_lanes[j].d1 - frames_ref[j].d1).norm(),
+                                   (frames_lanes[j].d2 - frames_ref[j].d2).norm(),
+                                   (tangents_lanes[j] - tangents_ref[j]).norm()});
+        worst_frame = std::max(worst_frame, e);
+        EXPECT_LT(e, 4e-15) << "nodes " << nodes << " edge " << j;
+      }
+      for (int i = 0; i < nodes; ++i) {
+        const double e = std::abs(twist[i] - twist_ref[i]);
+        worst_twist = std::max(worst_twist, e);
+        EXPECT_LT(e, 4e-15 + 1e-15 * std::abs(twist_ref[i])) << "nodes " << nodes << " node " << i;
+      }
+      if (path == FramePath::kPortable) {  // the reference itself, bit for bit
+        for (std::size_t j = 0; j < frames.size(); ++j) EXPECT_EQ(frames_lanes[j].d1, frames_ref[j].d1);
+        EXPECT_EQ(twist, twist_ref);
+      }
+    }
+  }
+  std::printf("lanes against the portable path: frames %.2e, twists %.2e apart at most\n",
+              worst_frame, worst_twist);
+}
+
+// Degenerate input fails on the lanes' path as on the portable one, with the same message.
+TEST(FramesTest, TransportFramesAndTwistsRejectsAZeroEdge) {
+  HelixGeometry g;
+  g.nodes = 12;
+  Matrix3X x = HelixNodes(g);
+  std::vector<RefFrame> frames = SpaceParallelFrames(x);
+  std::vector<Vec3> tangents = EdgeTangents(x);
+  x.col(6) = x.col(5);
+  VecX twist;
+  EXPECT_DEATH(TransportFramesAndTwists(x, &tangents, &frames, VecX(), &twist), "zero-length edge");
 }
 
 TEST(MaterialFrame, RotatesTheReferenceFrameByTheta) {

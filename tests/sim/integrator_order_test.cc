@@ -79,7 +79,9 @@ TEST(Predictor, SetsEachEdgeToItsExtrapolatedLengthInItsGuessedDirection) {
     ExtrapolateEdgeLengths(model, state.q, growth == 1.0 ? nullptr : &before, &lengths);
     SetEdgeLengths(model, lengths, &kept);
     for (int i = 0; i < rod.num_nodes(); ++i) {
-      if (fixed(i)) EXPECT_EQ(node(kept, i), node(guess, i)) << i;
+      if (fixed(i)) {
+        EXPECT_EQ(node(kept, i), node(guess, i)) << i;
+      }
       if (i == 0 || fixed(i)) continue;
       const Vec3 edge = node(kept, i) - node(kept, i - 1);
       const double length = (node(state.q, i) - node(state.q, i - 1)).norm();

@@ -126,6 +126,54 @@ TEST(BandedMatrix, FactorsAPositiveDefiniteMatrixWithoutPivoting) {
   }
 }
 
+// A definite band (diagonally dominant, slightly asymmetric): factorized without pivoting.
+BandedMatrix DefiniteBanded(int n, int kd, std::mt19937* rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  BandedMatrix a(n, kd);
+  const int k = a.half_bandwidth();
+  for (int i = 0; i < n; ++i)
+    for (int j = std::max(0, i - k); j <= std::min(n - 1, i + k); ++j)
+      a(i, j) = i == j ? 2.0 * k + 1.0 : u(*rng);
+  return a;
+}
+
+// SolveEach, two systems a row at a time where they match, against each matrix's own Solve: the
+// same bits, whether the pair is pivoted or not, of the rods' bandwidth or another, of equal or
+// different sizes (one after the other then), with an odd count (the last alone).
+TEST(BandedMatrix, SolveEachGivesEachMatrixsOwnSolveBitForBit) {
+  std::mt19937 rng(9);
+  for (const int kd : {10, 3}) {
+    for (const bool pivoted : {false, true}) {
+      for (const std::vector<int>& sizes :
+           std::vector<std::vector<int>>{{259, 259}, {259, 259, 259}, {259, 131}, {2, 2}}) {
+        std::vector<BandedMatrix> matrices;
+        for (const int n : sizes) {
+          matrices.push_back(pivoted ? RandomBanded(n, kd, true, &rng) : DefiniteBanded(n, kd, &rng));
+          ASSERT_TRUE(matrices.back().Factorize());
+          ASSERT_EQ(matrices.back().pivoted(), pivoted);
+        }
+        std::vector<VecX> each, own;
+        for (const int n : sizes) {
+          each.push_back(VecX::Random(n));
+          own.push_back(each.back());
+        }
+        each[0][0] = 0.0;  // a zero entry: the lower solve skips its column
+        own[0][0] = 0.0;
+        std::vector<const BandedMatrix*> pointers;
+        std::vector<double*> rhs;
+        for (std::size_t k = 0; k < sizes.size(); ++k) {
+          pointers.push_back(&matrices[k]);
+          rhs.push_back(each[k].data());
+          matrices[k].Solve(&own[k]);
+        }
+        SolveEach(pointers.data(), rhs.data(), static_cast<int>(sizes.size()));
+        for (std::size_t k = 0; k < sizes.size(); ++k)
+          EXPECT_EQ(each[k], own[k]) << "kd " << kd << ", pivoted " << pivoted << ", system " << k;
+      }
+    }
+  }
+}
+
 // Where elimination without interchanges meets a pivot that is not positive (an indefinite
 // matrix: here a negative diagonal entry in row 40 of an otherwise definite one) or its factors
 // grow (a positive definite symmetric part with a large skew part: [[1e-3, 1], [−1, 1]] grows

@@ -8,6 +8,7 @@
 #include <cstddef>
 
 #include "stokesrods/elastic/stencil_batch_lanes.h"
+#include "stokesrods/rod/frames.h"
 
 namespace stokesrods {
 
@@ -28,6 +29,22 @@ void BendTwistStencils(const StencilColumns& in, int count, bool with_jacobian,
     return BendTwistStencilsAvx2(in, count, with_jacobian, energy, gradient, jacobian);
 #endif
   StencilBatches<double, 1>(in, count, with_jacobian, energy, gradient, jacobian);
+}
+
+void MaterialFrames(const MaterialFrameColumns& frames, int count, StencilPath path) {
+#if defined(__x86_64__)
+  static const bool has_avx512 = __builtin_cpu_supports("avx512f");
+  static const bool has_avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  if (path == StencilPath::kWidest && has_avx512) return MaterialFramesAvx512(frames, count);
+  if (path != StencilPath::kPortable && has_avx2) return MaterialFramesAvx2(frames, count);
+#endif
+  for (int j = 0; j < count; ++j) {
+    const RefFrame f{Vec3(frames.d1[0][j], frames.d1[1][j], frames.d1[2][j]),
+                     Vec3(frames.d2[0][j], frames.d2[1][j], frames.d2[2][j])};
+    Vec3 m1, m2;
+    MaterialFrame(f, frames.theta[j], &m1, &m2);
+    for (int c = 0; c < 3; ++c) frames.m1[c][j] = m1[c], frames.m2[c][j] = m2[c];
+  }
 }
 
 }  // namespace stokesrods

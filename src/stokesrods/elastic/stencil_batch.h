@@ -22,4 +22,9 @@ enum class StencilPath { kWidest, kAvx2, kPortable };
 void BendTwistStencils(const StencilColumns& in, int count, bool with_jacobian,
                        StencilResults* out, StencilPath path = StencilPath::kWidest);
 
+/// The material directors of `count` edges (stencil_columns.h), several per vector where the CPU
+/// allows (the sine and cosine by glibc's vector math library), else by MaterialFrame.
+void MaterialFrames(const MaterialFrameColumns& frames, int count,
+                    StencilPath path = StencilPath::kWidest);
+
 }  // namespace stokesrods

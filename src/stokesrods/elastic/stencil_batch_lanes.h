@@ -70,5 +70,24 @@ void StencilBatches(const StencilColumns& in, int count, bool with_jacobian, dou
   }
 }
 
+// MaterialFrames' loop over batches of W edges (Math: the instruction set's Sin(V), Cos(V)).
+template <class V, int W, class Math>
+void MaterialFrameBatches(const MaterialFrameColumns& c, int count) {
+  static_assert(sizeof(V) == W * sizeof(double));
+  for (int j = 0; j < count; j += W) {
+    const int lanes = count - j < W ? count - j : W;
+    const V theta = LoadLanes<V, W>(c.theta, j, lanes);
+    const V cos = Math::Cos(theta), sin = Math::Sin(theta);
+    for (int k = 0; k < 3; ++k) {
+      const V d1 = LoadLanes<V, W>(c.d1[k], j, lanes), d2 = LoadLanes<V, W>(c.d2[k], j, lanes);
+      const V m1 = cos * d1 + sin * d2, m2 = cos * d2 - sin * d1;
+      double out1[W], out2[W];
+      __builtin_memcpy(out1, &m1, sizeof(V));
+      __builtin_memcpy(out2, &m2, sizeof(V));
+      for (int l = 0; l < lanes; ++l) c.m1[k][j + l] = out1[l], c.m2[k][j + l] = out2[l];
+    }
+  }
+}
+
 }  // namespace
 }  // namespace stokesrods

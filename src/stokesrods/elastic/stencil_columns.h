@@ -24,11 +24,25 @@ struct StencilColumns {
   const double* twist = nullptr;             ///< τ − τ̄
 };
 
+/// The material directors of edges by columns: m1 = cos θ d1 + sin θ d2, m2 = −sin θ d1 + cos θ d2
+/// (rod/frames.h MaterialFrame).
+struct MaterialFrameColumns {
+  const double* theta = nullptr;  ///< twist angle θ of each edge
+  const double* d1[3] = {};       ///< reference directors
+  const double* d2[3] = {};
+  double* m1[3] = {};             ///< out
+  double* m2[3] = {};
+};
+
 /// Per stencil s: energy[s], gradient[11 s … 11 s + 10] (stencil DOFs) and, with_jacobian,
 /// jacobian[121 s …] (11 × 11 by columns). Call only where the CPU has the instruction set.
 void BendTwistStencilsAvx512(const StencilColumns& in, int count, bool with_jacobian,
                              double* energy, double* gradient, double* jacobian);
 void BendTwistStencilsAvx2(const StencilColumns& in, int count, bool with_jacobian,
                            double* energy, double* gradient, double* jacobian);
+/// The material directors of `count` edges; the sine and cosine by glibc's vector math library
+/// (libmvec). Call only where the CPU has the instruction set.
+void MaterialFramesAvx512(const MaterialFrameColumns& frames, int count);
+void MaterialFramesAvx2(const MaterialFrameColumns& frames, int count);
 
 }  // namespace stokesrods

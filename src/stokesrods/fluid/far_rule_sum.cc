@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 
 #include "stokesrods/common/assert.h"
+#include "stokesrods/common/parallel.h"
 #include "stokesrods/fluid/mobility_operator.h"
 #include "stokesrods/fluid/stokeslet_segment.h"
 
@@ -197,8 +198,7 @@ void FarRuleSum::Build(const Matrix3X& nodes, const std::vector<int>& first_node
 
 void FarRuleSum::FillStrengths(const Matrix3X& density) const {
   const int segments = static_cast<int>(first_node_.size());
-#pragma omp parallel for schedule(static)
-  for (int s = 0; s < segments; ++s) {
+  ForEachStatic(segments, segments > 1, [&](int s) {
     const Vec3 fa = density.col(first_node_[static_cast<size_t>(s)]);
     const Vec3 fb = density.col(first_node_[static_cast<size_t>(s)] + 1);
     for (const Rule& rule : rules_)
@@ -210,7 +210,7 @@ void FarRuleSum::FillStrengths(const Matrix3X& density) const {
         else
           src_.row(row).tail<3>() = g.transpose();
       }
-  }
+  });
 }
 
 void FarRuleSum::Apply(const Matrix3X& density, Matrix3X* w) const {
@@ -223,8 +223,7 @@ void FarRuleSum::Apply(const Matrix3X& density, Matrix3X* w) const {
   const int groups = (m + kGroupTargets - 1) / kGroupTargets;
   static_assert(kGroupTargets % kPointSumTargets == 0, "whole passes per group");
   constexpr int kPasses = kGroupTargets / kPointSumTargets;
-#pragma omp parallel for schedule(static)
-  for (int g = 0; g < groups; ++g) {
+  ForEachStatic(groups, groups > 1, [&](int g) {
     const int end = std::min(m, (g + 1) * kGroupTargets);
     for (int t0 = g * kGroupTargets, p = g * kPasses; t0 < end; t0 += kPointSumTargets, ++p) {
       const int n = std::min(kPointSumTargets, end - t0);
@@ -251,7 +250,7 @@ void FarRuleSum::Apply(const Matrix3X& density, Matrix3X* w) const {
         sum(own_range_.data() + own_start_[t], own_start_[t + 1] - own_start_[t], 1, k);
       }
     }
-  }
+  });
 }
 
 }  // namespace stokesrods

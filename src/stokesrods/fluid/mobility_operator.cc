@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 
 #include "stokesrods/common/assert.h"
+#include "stokesrods/common/parallel.h"
 #include "stokesrods/fluid/far_rule_sum.h"
 #include "stokesrods/fluid/near_search.h"
 #include "stokesrods/fluid/rss.h"
@@ -87,16 +88,28 @@ class DenseMobility final : public MobilityOperator {
     velocity->resize(n);
     if (products_) {
       constexpr Eigen::Index kRows = 64;
-#pragma omp parallel for schedule(static, 1) if (n > 4 * kRows)
-      for (Eigen::Index first = 0; first < n; first += kRows)
+      const auto rows = [&](Eigen::Index first) {
         GemvRowsMixed(*products_, first, std::min(kRows, n - first), force.data(),
                       velocity->data() + first);
+      };
+      if (!Parallel(n > 4 * kRows)) {
+        for (Eigen::Index first = 0; first < n; first += kRows) rows(first);
+        return;
+      }
+#pragma omp parallel for schedule(static, 1)
+      for (Eigen::Index first = 0; first < n; first += kRows) rows(first);
       return;
     }
     constexpr Eigen::Index kRows = 192;
-#pragma omp parallel for schedule(static) if (n > 2 * kRows)
-    for (Eigen::Index first = 0; first < n; first += kRows)
+    const auto rows = [&](Eigen::Index first) {
       GemvRows(matrix_, first, std::min(kRows, n - first), force.data(), velocity->data() + first);
+    };
+    if (!Parallel(n > 2 * kRows)) {
+      for (Eigen::Index first = 0; first < n; first += kRows) rows(first);
+      return;
+    }
+#pragma omp parallel for schedule(static)
+    for (Eigen::Index first = 0; first < n; first += kRows) rows(first);
   }
   MatX SelfBlock(int rod) const override {
     const int first = 3 * node_offset(rod), n = 3 * (node_offset(rod + 1) - node_offset(rod));
@@ -699,10 +712,9 @@ void MatrixFreeRssMobility::Apply(const VecX& force, VecX* velocity) const {
   }
   velocity->resize(3 * m);
   const double scale = 1.0 / (8.0 * kPi * params_.viscosity);
-#pragma omp parallel for schedule(static)
-  for (int t = 0; t < m; ++t) {
+  ForEachStatic(m, m > 1, [&](int t) {
     velocity->segment<3>(3 * t) = scale * far_velocity_.col(t) + near_.At(t, force);
-  }
+  });
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 
+#include "stokesrods/common/parallel.h"
 #include "stokesrods/common/types.h"
 
 namespace stokesrods {
@@ -23,9 +24,9 @@ template <class Body>
 void ForTwoParts(Eigen::Index n, const Body& body) {
   if (n < kTwoPartsFrom) return body(0, Eigen::Index{0}, n);
   const Eigen::Index cut = (n / 2 + 15) / 16 * 16;
-#pragma omp parallel for schedule(static)
-  for (int part = 0; part < 2; ++part)
+  ForEachStatic(2, true, [&](int part) {
     body(part, part == 0 ? Eigen::Index{0} : cut, part == 0 ? cut : n - cut);
+  });
 }
 
 /// d (n entries) rounded to half precision at the scale σ, a power of two that puts its largest

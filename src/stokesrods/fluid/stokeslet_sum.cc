@@ -14,6 +14,7 @@
 #include <cmath>
 
 #include "stokesrods/common/assert.h"
+#include "stokesrods/common/parallel.h"
 #include "stokesrods/fluid/point_stokeslet.h"
 
 namespace stokesrods {
@@ -227,24 +228,22 @@ class DirectStokesletSum final : public StokesletSum {
     if (single_) {
       src_f_.rightCols<3>() = strengths.transpose().cast<float>();
       const SourceColumnsF c = ColumnsF(src_f_);
-#pragma omp parallel for schedule(static)
-      for (Eigen::Index g = 0; g < groups; ++g) {
+      ForEachStatic(static_cast<int>(groups), groups > 1, [&](int g) {
         const float* x[kPointSumTargets];
         double* out[kPointSumTargets];
         const int n = Group(g, nt, targets_f_, w, x, out);
         AddPointSumRangesTargets(c, &all, 1, n, x, out);
-      }
+      });
       return;
     }
     src_.rightCols<3>() = strengths.transpose();
     const SourceColumns c = Columns(src_);
-#pragma omp parallel for schedule(static)
-    for (Eigen::Index g = 0; g < groups; ++g) {
+    ForEachStatic(static_cast<int>(groups), groups > 1, [&](int g) {
       const double* x[kPointSumTargets];
       double* out[kPointSumTargets];
       const int n = Group(g, nt, targets_, w, x, out);
       AddPointSumRangesTargets(c, &all, 1, n, x, out);
-    }
+    });
   }
 
   StokesletSumStats Stats() const override {

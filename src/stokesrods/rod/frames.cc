@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "stokesrods/common/assert.h"
+#include "stokesrods/rod/frame_columns.h"
 
 namespace stokesrods {
 
@@ -98,6 +99,85 @@ VecX ReferenceTwists(const std::vector<RefFrame>& frames, const std::vector<Vec3
     twist[i] = ReferenceTwist(frames[e - 1], tangents[e - 1], frames[e], tangents[e], prev);
   }
   return twist;
+}
+
+namespace {
+
+// The lanes' pass of TransportFramesAndTwists on `path`, or false where the path is not this
+// CPU's or the input is degenerate (the portable functions then say how).
+bool TransportFramesInLanes(const Matrix3X& x_new, std::vector<Vec3>* tangents,
+                            std::vector<RefFrame>* frames, const VecX& previous_twist,
+                            VecX* twist, FramePath path) {
+#if defined(__x86_64__)
+  static const bool has_avx512 = __builtin_cpu_supports("avx512f");
+  static const bool has_avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  const bool avx512 = path == FramePath::kWidest && has_avx512;
+  if (!avx512 && (path == FramePath::kPortable || !has_avx2)) return false;
+  const Eigen::Index nodes = x_new.cols();
+  const auto edges = static_cast<std::size_t>(nodes - 1);
+  if (nodes < 2 || tangents->size() != edges || frames->size() != edges ||
+      (previous_twist.size() != 0 && previous_twist.size() != nodes))
+    return false;
+  // Columns: x (3 × nodes), then 3 each of the old tangents, old d1, tangents, d1, d2, and the
+  // angles (edges each). Kept: no allocation per call.
+  thread_local std::vector<double> scratch;
+  const auto n = static_cast<std::size_t>(nodes);
+  scratch.resize(3 * n + 16 * edges);
+  FrameColumns c;
+  double* next = scratch.data();
+  for (int k = 0; k < 3; ++k, next += n) {
+    for (std::size_t i = 0; i < n; ++i) next[i] = x_new(k, static_cast<Eigen::Index>(i));
+    c.x[k] = next;
+  }
+  for (int k = 0; k < 3; ++k, next += edges) {
+    for (std::size_t j = 0; j < edges; ++j) next[j] = (*tangents)[j][k];
+    c.old_tangent[k] = next;
+  }
+  for (int k = 0; k < 3; ++k, next += edges) {
+    for (std::size_t j = 0; j < edges; ++j) next[j] = (*frames)[j].d1[k];
+    c.old_d1[k] = next;
+  }
+  for (int k = 0; k < 3; ++k) c.tangent[k] = next, next += edges;
+  for (int k = 0; k < 3; ++k) c.d1[k] = next, next += edges;
+  for (int k = 0; k < 3; ++k) c.d2[k] = next, next += edges;
+  c.angle = next;
+  const int count = static_cast<int>(edges);
+  if (avx512)
+    TransportFrameLanesAvx512(count, &c);
+  else
+    TransportFrameLanesAvx2(count, &c);
+  // The portable functions' checks (EdgeTangents, ParallelTransport, OrthonormalFrame).
+  if (!(c.smallest[0] > 0.0 && c.smallest[1] > 1e-12 && c.smallest[2] > 1e-8)) return false;
+  for (std::size_t i = 0; i + 1 < edges; ++i)
+    if (!std::isfinite(c.angle[i])) return false;
+  for (std::size_t j = 0; j < edges; ++j)
+    for (int k = 0; k < 3; ++k) {
+      (*tangents)[j][k] = c.tangent[k][j];
+      (*frames)[j].d1[k] = c.d1[k][j];
+      (*frames)[j].d2[k] = c.d2[k][j];
+    }
+  twist->setZero(nodes);
+  const double two_pi = 2.0 * kPi;
+  for (Eigen::Index i = 1; i + 1 < nodes; ++i) {  // as ReferenceTwist's
+    const double angle = c.angle[i - 1];
+    const double previous = previous_twist.size() == 0 ? 0.0 : previous_twist[i];
+    (*twist)[i] = angle + two_pi * std::round((previous - angle) / two_pi);
+  }
+  return true;
+#else
+  (void)x_new, (void)tangents, (void)frames, (void)previous_twist, (void)twist, (void)path;
+  return false;
+#endif
+}
+
+}  // namespace
+
+void TransportFramesAndTwists(const Matrix3X& x_new, std::vector<Vec3>* tangents,
+                              std::vector<RefFrame>* frames, const VecX& previous_twist,
+                              VecX* twist, FramePath path) {
+  if (TransportFramesInLanes(x_new, tangents, frames, previous_twist, twist, path)) return;
+  TransportFramesInTime(x_new, tangents, frames);
+  *twist = ReferenceTwists(*frames, *tangents, previous_twist);
 }
 
 void MaterialFrame(const RefFrame& f, double theta, Vec3* m1, Vec3* m2) {

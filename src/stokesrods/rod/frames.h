@@ -56,6 +56,19 @@ double ReferenceTwist(const RefFrame& f0, const Vec3& t0, const RefFrame& f1, co
 VecX ReferenceTwists(const std::vector<RefFrame>& frames, const std::vector<Vec3>& tangents,
                      const VecX& previous);
 
+/// Which instruction set transports the frames (tests run each where the CPU has it).
+enum class FramePath { kWidest, kAvx2, kPortable };
+
+/// TransportFramesInTime(x_new, tangents, frames), then twist = ReferenceTwists(*frames,
+/// *tangents, previous_twist), in one pass: AVX-512 (eight edges per vector) or AVX2 with FMA
+/// (four) where the CPU has them (rod/frame_lanes.h: the same formulas in another order of
+/// rounding, the arctangent by glibc's vector math library), else (kPortable) by those two
+/// functions, which are the reference (FramesTest.TransportFramesAndTwistsOnEachPath). Degenerate
+/// input (a zero edge, opposite tangents) fails as those two functions fail.
+void TransportFramesAndTwists(const Matrix3X& x_new, std::vector<Vec3>* tangents,
+                              std::vector<RefFrame>* frames, const VecX& previous_twist,
+                              VecX* twist, FramePath path = FramePath::kWidest);
+
 /// Material frame of an edge: m1 = cos θ d1 + sin θ d2, m2 = −sin θ d1 + cos θ d2.
 void MaterialFrame(const RefFrame& f, double theta, Vec3* m1, Vec3* m2);
 

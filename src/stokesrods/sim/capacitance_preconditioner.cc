@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "stokesrods/common/assert.h"
+#include "stokesrods/common/parallel.h"
 
 namespace stokesrods {
 
@@ -195,14 +196,13 @@ void CapacitancePreconditioner::SolveBlocks(const VecX& v, VecX* out) const {
   // each application streams them from memory. Each thread takes consecutive blocks (static) and
   // prefetches the next one's factors before it solves one: on 100 helices the solves and the
   // prefetches together take 0.82 of the solves' time without (docs/performance.md, "Session 13").
-#pragma omp parallel for schedule(static) if (num_blocks > 1)
-  for (int k = 0; k < num_blocks; ++k) {  // the blocks' entries are disjoint
+  ForEachStatic(num_blocks, num_blocks > 1, [&](int k) {  // the blocks' entries are disjoint
     const Block& block = blocks_[static_cast<size_t>(k)];
     if (k + 1 < num_blocks) blocks_[static_cast<size_t>(k) + 1].lu.Prefetch();
     Eigen::VectorXf x = block.Gather(v).cast<float>();
     block.lu.Solve(&x);
     block.Scatter(x.cast<double>(), out);
-  }
+  });
 }
 
 void CapacitancePreconditioner::SolveFine(const VecX& v, VecX* out) const {

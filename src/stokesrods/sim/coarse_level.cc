@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "stokesrods/common/assert.h"
+#include "stokesrods/common/parallel.h"
 #include "stokesrods/solver/blas.h"
 
 namespace stokesrods {
@@ -412,8 +413,7 @@ void CoarseLevel::ApplyW(const VecX& c, VecX* out) const {
   between_->Apply(strengths_, &velocity_);  // every point, its own rod's too
   out->resize(3 * m);
   const int num_rods = static_cast<int>(own_.size());
-#pragma omp parallel for schedule(static) if (num_rods > 1)
-  for (int r = 0; r < num_rods; ++r) {
+  ForEachStatic(num_rods, num_rods > 1, [&](int r) {
     const int first = rod_first_node_[static_cast<size_t>(r)];
     const int n = rod_first_node_[static_cast<size_t>(r) + 1] - first;
     const int c0 = rod_first_chunk_[static_cast<size_t>(r)];
@@ -433,7 +433,7 @@ void CoarseLevel::ApplyW(const VecX& c, VecX* out) const {
       }
       out->segment<3>(3 * i) += u;
     }
-  }
+  });
 }
 
 void CoarseLevel::AddZ(const VecX& c, VecX* out) const {

@@ -26,7 +26,7 @@ void AddStretchingBlocks(int a, int b, const Mat6& h6, BandedMatrix* hessian) {
 
 // The forces, and the Jacobian where `hessian` is given, by edges: each edge's vector, length and
 // material directors are computed once (one sine and one cosine per edge, where the stencils'
-// own calls take two per stencil) into columns, and the bending and twisting of all stencils are
+// own calls take two per stencil; several edges per vector: MaterialFrames) into columns, and the bending and twisting of all stencils are
 // then computed several at a time, one per vector lane (elastic/stencil_batch.h; the formulas in
 // elastic/stencil_lanes.h). The arithmetic of StretchingEnergy, BendingEdgeEnergy and
 // TwistingEdgeEnergy otherwise; ElasticAssembly.* (tests/sim/jacobian_test.cc) compares it with
@@ -38,7 +38,8 @@ double AddElasticForcesByEdge(const RodModel& rod, const VecX& q, const RodFrame
   auto x = [&](int i) { return Vec3(q.segment<3>(o + NodeDof(i))); };
   double energy = 0.0;
   // Kept: no allocation per evaluation. Columns of the edges and of the stencils, by first column:
-  enum EdgeColumn { kEdge = 0, kLength = 3, kM1 = 4, kM2 = 7, kEdgeColumns = 10 };
+  enum EdgeColumn { kEdge = 0, kLength = 3, kM1 = 4, kM2 = 7, kTheta = 10, kD1 = 11, kD2 = 14,
+                    kEdgeColumns = 17 };
   enum StencilColumn { kKb = 0, kD = 3, kExcess = 4, kBend = 6, kTwistStiffness = 7, kTwist = 8,
                        kStencilColumns = 9 };
   thread_local std::vector<double> edge_columns, stencil_columns;
@@ -48,17 +49,25 @@ double AddElasticForcesByEdge(const RodModel& rod, const VecX& q, const RodFrame
   stencil_columns.resize(kStencilColumns * stencils);
   auto edge_column = [&](int k) { return edge_columns.data() + k * edges; };
   auto stencil_column = [&](int k) { return stencil_columns.data() + k * stencils; };
+  MaterialFrameColumns material;
+  material.theta = edge_column(kTheta);
+  for (int j = 0; j + 1 < n; ++j) {
+    const RefFrame& f = frames.frames[static_cast<size_t>(j)];
+    edge_column(kTheta)[j] = q(o + TwistDof(j));
+    for (int c = 0; c < 3; ++c) edge_column(kD1 + c)[j] = f.d1[c], edge_column(kD2 + c)[j] = f.d2[c];
+  }
+  for (int c = 0; c < 3; ++c) {
+    material.d1[c] = edge_column(kD1 + c);
+    material.d2[c] = edge_column(kD2 + c);
+    material.m1[c] = edge_column(kM1 + c);
+    material.m2[c] = edge_column(kM2 + c);
+  }
+  MaterialFrames(material, n - 1, path);
   Vec6 g6;
   Mat6 h6;
   for (int j = 0; j + 1 < n; ++j) {
     const Vec3 e = x(j + 1) - x(j);
-    Vec3 m1, m2;
-    MaterialFrame(frames.frames[static_cast<size_t>(j)], q(o + TwistDof(j)), &m1, &m2);
-    for (int c = 0; c < 3; ++c) {
-      edge_column(kEdge + c)[j] = e[c];
-      edge_column(kM1 + c)[j] = m1[c];
-      edge_column(kM2 + c)[j] = m2[c];
-    }
+    for (int c = 0; c < 3; ++c) edge_column(kEdge + c)[j] = e[c];
     edge_column(kLength)[j] = e.norm();
     energy += StretchingEnergy({rod.axial_stiffness, rod.rest_edge_length(j)}, x(j), x(j + 1),
                                &g6, hessian ? &h6 : nullptr);

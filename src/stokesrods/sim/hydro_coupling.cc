@@ -7,6 +7,7 @@
 #include <Eigen/SVD>
 
 #include "stokesrods/common/assert.h"
+#include "stokesrods/common/parallel.h"
 #include "stokesrods/fluid/mobility_sources.h"
 #include "stokesrods/fluid/wall_sources.h"
 #include "stokesrods/sim/bodies.h"
@@ -24,6 +25,33 @@ void GatherNodeVelocities(const Model& model, const VecX& q, const VecX& q_start
       const int k = rod.dof_offset + NodeDof(i);
       u->segment<3>(3 * (rod.node_offset + i)) = (q.segment<3>(k) - q_start.segment<3>(k)) / h;
     }
+}
+
+void SolveRodsBanded(const Model& model, const std::vector<BandedMatrix>& jacobian, VecX* x) {
+  const int num_rods = static_cast<int>(model.rods.size());
+  auto solve = [&](int first, int last) {  // rods first … last − 1
+    for (int r = first; r < last; r += 2) {
+      const int count = std::min(2, last - r);
+      const BandedMatrix* matrices[2];
+      double* rhs[2];
+      for (int k = 0; k < count; ++k) {
+        const auto rod = static_cast<std::size_t>(r + k);
+        matrices[k] = &jacobian[rod];
+        rhs[k] = x->data() + model.rods[rod].dof_offset;
+      }
+      SolveEach(matrices, rhs, count);
+    }
+  };
+  if (!Parallel(num_rods > 1)) return solve(0, num_rods);
+#pragma omp parallel
+  {
+#ifdef _OPENMP
+    const int thread = omp_get_thread_num(), threads = omp_get_num_threads();
+#else
+    const int thread = 0, threads = 1;
+#endif
+    solve(num_rods * thread / threads, num_rods * (thread + 1) / threads);
+  }
 }
 
 std::unique_ptr<MobilityOperator> MakeModelMobility(const Model& model) {
@@ -177,10 +205,11 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
                                           std::vector<ClampBorder>* borders) {
   SR_ASSERT(!explicit_, "the capacitance solve is for the implicit coupling");
   const int num_rods = static_cast<int>(jacobian->size());
-  bool regular = true;
-#pragma omp parallel for schedule(static) reduction(&& : regular) if (num_rods > 1)
-  for (int r = 0; r < num_rods; ++r) regular = (*jacobian)[static_cast<size_t>(r)].Factorize() && regular;
-  if (!regular) return false;
+  std::vector<char> regular(jacobian->size());
+  ForEachStatic(num_rods, num_rods > 1, [&](int r) {
+    regular[static_cast<size_t>(r)] = (*jacobian)[static_cast<size_t>(r)].Factorize();
+  });
+  if (std::find(regular.begin(), regular.end(), 0) != regular.end()) return false;
   jacobian_ = jacobian;
   borders_ = borders;
   if (borders) CompleteClampBorders(model, *jacobian, borders);
@@ -231,8 +260,7 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
 void HydroCoupling::BuildSchurBlocks(const Model& model) {
   sx_blocks_.resize(model.rods.size());
   const int num_rods = static_cast<int>(model.rods.size());
-#pragma omp parallel for schedule(dynamic) if (num_rods > 1)
-  for (int ri = 0; ri < num_rods; ++ri) {  // each rod's own block (and its borders' rows)
+  ForEachDynamic(num_rods, num_rods > 1, [&](int ri) {  // each rod's own block (and its borders' rows)
     const auto r = static_cast<std::size_t>(ri);
     const RodModel& rod = model.rods[r];
     const int n = rod.num_nodes();
@@ -249,7 +277,7 @@ void HydroCoupling::BuildSchurBlocks(const Model& model) {
     if (borders_)
       for (ClampBorder& border : *borders_)
         if (border.rod == static_cast<int>(r)) border.row_x = border.rows * x;
-  }
+  });
 }
 
 void HydroCoupling::SolveBanded(const Model& model, const VecX& nodal, const VecX* dofs,
@@ -261,11 +289,7 @@ void HydroCoupling::SolveBanded(const Model& model, const VecX& nodal, const Vec
       out->segment<3>(rod.dof_offset + NodeDof(i)) += nodal.segment<3>(3 * (rod.node_offset + i));
     for (int k : rod.fixed_dofs) (*out)(rod.dof_offset + k) = dofs ? (*dofs)(rod.dof_offset + k) : 0.0;
   }
-  const int num_rods = static_cast<int>(model.rods.size());
-#pragma omp parallel for schedule(static) if (num_rods > 1)
-  for (int r = 0; r < num_rods; ++r)  // each rod's own DOFs
-    (*jacobian_)[static_cast<size_t>(r)].Solve(
-        out->data() + model.rods[static_cast<size_t>(r)].dof_offset, 1);
+  SolveRodsBanded(model, *jacobian_, out);
 }
 
 void HydroCoupling::ApplyCapacitance(const Model& model, double h, const VecX& v,
@@ -302,13 +326,12 @@ void HydroCoupling::UpdatePreconditionerRotations(const Model& model) {
   RodRotations& q = preconditioner_rotations_;
   q.rotation.resize(positions_.size());
   const int num_rods = static_cast<int>(positions_.size());
-#pragma omp parallel for schedule(static) if (num_rods > 1)
-  for (int ri = 0; ri < num_rods; ++ri) {
+  ForEachStatic(num_rods, num_rods > 1, [&](int ri) {
     const auto r = static_cast<std::size_t>(ri);
     q.rotation[r] = Mat3::Identity();
     // A rod clamped on a body turns with it; its cell's block holds the body's points, which
     // stay as built: the rod's block is applied as built too.
-    if (model.rods[r].body >= 0) continue;
+    if (model.rods[r].body >= 0) return;
     // Kabsch: the rotation R maximizing Σ (x_i − x̄)ᵀ R (x⁰_i − x̄⁰) is U diag(1, 1, ±1) Vᵀ
     // from the SVD U Σ Vᵀ of Σ (x_i − x̄)(x⁰_i − x̄⁰)ᵀ, the sign making det R = +1.
     const Matrix3X& now = positions_[r];
@@ -318,7 +341,7 @@ void HydroCoupling::UpdatePreconditionerRotations(const Model& model) {
     Mat3 sign = Mat3::Identity();
     if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0) sign(2, 2) = -1.0;
     q.rotation[r] = svd.matrixU() * sign * svd.matrixV().transpose();
-  }
+  });
 }
 
 void RodRotations::Apply(bool transpose, VecX* x) const {
@@ -358,15 +381,10 @@ HydroSolveReport HydroCoupling::SolveNewtonSystem(const Model& model,
   // y = −B⁻¹ r_q, and S y.
   *dq = -r_q;
   VecX sy = VecX::Zero(mobility_->size());  // zero on the bodies' points (no S there)
-  const int num_rods = static_cast<int>(model.rods.size());
-#pragma omp parallel for schedule(static) if (num_rods > 1)
-  for (int ri = 0; ri < num_rods; ++ri) {  // each rod's own DOFs and nodes
-    const auto r = static_cast<std::size_t>(ri);
-    const RodModel& rod = model.rods[r];
-    jacobian[r].Solve(dq->data() + rod.dof_offset, 1);
+  SolveRodsBanded(model, jacobian, dq);
+  for (const RodModel& rod : model.rods)
     for (int i = 0; i < rod.num_nodes(); ++i)
       sy.segment<3>(3 * (rod.node_offset + i)) = dq->segment<3>(rod.dof_offset + NodeDof(i));
-  }
   for (const RodModel& rod : model.rods)  // S selects free DOFs only (X has zero fixed rows)
     for (int k : rod.fixed_dofs)
       if (k % 4 != 3) sy(3 * rod.node_offset + 3 * (k / 4) + k % 4) = 0.0;

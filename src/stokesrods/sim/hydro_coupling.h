@@ -184,6 +184,11 @@ class HydroCoupling {
 void GatherNodeVelocities(const Model& model, const VecX& q, const VecX& q_start, double h,
                           VecX* u);
 
+/// Each rod's Newton matrix solved in place on its DOFs of x (the model's DOFs): B_k⁻¹ x_k. The
+/// rods are split among the threads as a static OpenMP loop splits them, and each thread's rods
+/// are solved two at a time (SolveEach: bit for bit each rod's own Solve).
+void SolveRodsBanded(const Model& model, const std::vector<BandedMatrix>& jacobian, VecX* x);
+
 /// The mobility operator of the model: model.hydro.mobility's, with the bodies' points behind a
 /// matrix-free one (fluid/mobility_sources.h).
 std::unique_ptr<MobilityOperator> MakeModelMobility(const Model& model);

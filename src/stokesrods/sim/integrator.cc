@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "stokesrods/common/parallel.h"
 #include "stokesrods/sim/bodies.h"
 #include "stokesrods/sim/clamp_border.h"
 #include "stokesrods/sim/elastic_assembly.h"
@@ -105,12 +106,11 @@ void Evaluate(const Model& model, const State& start, double h, const VecX& q,
   std::vector<BandedMatrix>* jac = with_jacobian ? &ws->jacobian : nullptr;
   // Rods in parallel: each writes only its own DOFs of the force and its own banded matrix.
   const int num_rods = static_cast<int>(model.rods.size());
-#pragma omp parallel for schedule(dynamic) if (num_rods > 1)
-  for (int r = 0; r < num_rods; ++r) {
+  ForEachDynamic(num_rods, num_rods > 1, [&](int r) {
     if (jac) (*jac)[static_cast<size_t>(r)].SetZero();
     AddElasticForces(model.rods[static_cast<size_t>(r)], q, (*frames)[static_cast<size_t>(r)],
                      &ws->force, jac ? &(*jac)[static_cast<size_t>(r)] : nullptr);
-  }
+  });
   const StepContext ctx{&start.q, h, ws->load_factor};
   for (const auto& f : ws->local_forces) f->AddTo(model, ctx, q, &ws->force, jac);
   if (h > 0.0 && ws->nonlocal_fluid) HydroCoupling::AddNodalForce(model, hydro_force, &ws->force);

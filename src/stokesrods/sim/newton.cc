@@ -140,8 +140,7 @@ int NewtonCorrection(const Model& model, double h, const VecX& residual, const V
     return report.krylov_iterations;
   }
   *dq = -residual;
-  for (std::size_t r = 0; r < model.rods.size(); ++r)
-    ws->jacobian[r].Solve(dq->data() + model.rods[r].dof_offset, 1);
+  SolveRodsBanded(model, ws->jacobian, dq);
   return 0;
 }
 

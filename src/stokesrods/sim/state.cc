@@ -1,5 +1,7 @@
 #include "stokesrods/sim/state.h"
 
+#include "stokesrods/common/parallel.h"
+
 namespace stokesrods {
 
 Matrix3X RodPositions(const Model& model, int r, const VecX& q) {
@@ -30,16 +32,15 @@ void TransportFrames(const Model& model, const VecX& q, const std::vector<RodFra
                      std::vector<RodFrames>* to) {
   to->resize(from.size());
   const int num_rods = static_cast<int>(from.size());
-#pragma omp parallel for schedule(dynamic) if (num_rods > 1)
-  for (int ri = 0; ri < num_rods; ++ri) {
+  ForEachDynamic(num_rods, num_rods > 1, [&](int ri) {
     const auto r = static_cast<std::size_t>(ri);
     RodFrames& out = (*to)[r];
     out.frames = from[r].frames;
     out.tangents = from[r].tangents;
     const Matrix3X x = RodPositions(model, static_cast<int>(r), q);
-    TransportFramesInTime(x, &out.tangents, &out.frames);
-    out.reference_twist = ReferenceTwists(out.frames, out.tangents, from[r].reference_twist);
-  }
+    TransportFramesAndTwists(x, &out.tangents, &out.frames, from[r].reference_twist,
+                             &out.reference_twist);
+  });
 }
 
 }  // namespace stokesrods

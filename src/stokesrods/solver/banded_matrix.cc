@@ -166,6 +166,43 @@ inline __attribute__((always_inline)) void SolveBand(int n, int kd_runtime, bool
   }
 }
 
+// Two systems of the same size, bandwidth and pivoting, one right-hand side each, row by row in
+// turn: each system's operations exactly as SolveBand's (the same bits), but two independent
+// chains of dependent updates for the CPU to overlap, where one solve after the other leaves it
+// waiting on each row's update of the next.
+template <int KD, int KU>
+inline __attribute__((always_inline)) void SolveBandPair(int n, int kd_runtime, bool pivoted,
+                                                         const double* ab_a, const int* pivots_a,
+                                                         const double* inverse_diagonal_a,
+                                                         double* x_a, const double* ab_b,
+                                                         const int* pivots_b,
+                                                         const double* inverse_diagonal_b,
+                                                         double* x_b) {
+  const int kd = KD > 0 ? KD : kd_runtime, kv = 2 * kd, ldab = 3 * kd + 1;
+  const int ku = KU > 0 ? KU : (pivoted ? kv : kd);
+  auto lower = [&](int j, const double* ab, const int* pivots, double* x) {
+    const int p = pivots[j];
+    if (p != j) std::swap(x[j], x[p]);
+    if (x[j] == 0.0) return;
+    const double* column = ab + kv + static_cast<std::ptrdiff_t>(j) * ldab;
+    Axpy<KD>(std::min(kd, n - 1 - j), x[j], column + 1, x + j + 1);
+  };
+  auto upper = [&](int j, const double* ab, const double* inverse_diagonal, double* x) {
+    const double* column = ab + static_cast<std::ptrdiff_t>(j) * ldab;
+    x[j] *= inverse_diagonal[j];
+    const int top = std::max(0, j - ku);
+    Axpy<KU>(j - top, x[j], column + kv + top - j, x + top);
+  };
+  for (int j = 0; j + 1 < n; ++j) {
+    lower(j, ab_a, pivots_a, x_a);
+    lower(j, ab_b, pivots_b, x_b);
+  }
+  for (int j = n - 1; j >= 0; --j) {
+    upper(j, ab_a, inverse_diagonal_a, x_a);
+    upper(j, ab_b, inverse_diagonal_b, x_b);
+  }
+}
+
 // num_rhs right-hand sides stored by rows (x(i, k) at x[i · num_rhs + k]): each row operation one
 // long vector operation across them.
 template <int KD>
@@ -218,6 +255,22 @@ void Solve(int n, int kd, bool pivoted, const double* ab, const int* pivots,
     return SolveBand<kRodHalfBandwidth, 2 * kRodHalfBandwidth>(n, kd, pivoted, ab, pivots,
                                                                inverse_diagonal, x);
   SolveBand<kRodHalfBandwidth, kRodHalfBandwidth>(n, kd, pivoted, ab, pivots, inverse_diagonal, x);
+}
+
+__attribute__((target_clones("avx512f", "avx2", "default")))
+void SolvePair(int n, int kd, bool pivoted, const double* ab_a, const int* pivots_a,
+               const double* inverse_diagonal_a, double* x_a, const double* ab_b,
+               const int* pivots_b, const double* inverse_diagonal_b, double* x_b) {
+  if (kd != kRodHalfBandwidth)
+    return SolveBandPair<0, 0>(n, kd, pivoted, ab_a, pivots_a, inverse_diagonal_a, x_a, ab_b,
+                               pivots_b, inverse_diagonal_b, x_b);
+  if (pivoted)
+    return SolveBandPair<kRodHalfBandwidth, 2 * kRodHalfBandwidth>(
+        n, kd, pivoted, ab_a, pivots_a, inverse_diagonal_a, x_a, ab_b, pivots_b,
+        inverse_diagonal_b, x_b);
+  SolveBandPair<kRodHalfBandwidth, kRodHalfBandwidth>(n, kd, pivoted, ab_a, pivots_a,
+                                                      inverse_diagonal_a, x_a, ab_b, pivots_b,
+                                                      inverse_diagonal_b, x_b);
 }
 
 __attribute__((target_clones("avx512f", "avx2", "default")))
@@ -276,6 +329,23 @@ void BandedMatrix::Solve(double* b, int num_rhs) const {
   for (int k = 0; k < num_rhs; ++k)
     stokesrods::Solve(n_, kd_, pivoted_, ab_.data(), pivots_.data(), inverse_diagonal_.data(),
                       b + static_cast<std::ptrdiff_t>(k) * n_);
+}
+
+void SolveEach(const BandedMatrix* const* matrices, double* const* rhs, int count) {
+  int k = 0;
+  for (; k + 1 < count; k += 2) {
+    const BandedMatrix& a = *matrices[k];
+    const BandedMatrix& b = *matrices[k + 1];
+    SR_ASSERT(a.factorized_ && b.factorized_, "Solve before Factorize");
+    if (a.n_ != b.n_ || a.kd_ != b.kd_ || a.pivoted_ != b.pivoted_) {
+      a.Solve(rhs[k], 1);
+      b.Solve(rhs[k + 1], 1);
+      continue;
+    }
+    SolvePair(a.n_, a.kd_, a.pivoted_, a.ab_.data(), a.pivots_.data(), a.inverse_diagonal_.data(),
+              rhs[k], b.ab_.data(), b.pivots_.data(), b.inverse_diagonal_.data(), rhs[k + 1]);
+  }
+  if (k < count) matrices[k]->Solve(rhs[k], 1);
 }
 
 void BandedMatrix::SolveManyRows(double* b, int num_rhs) const {

@@ -15,6 +15,13 @@
 
 namespace stokesrods {
 
+class BandedMatrix;
+
+/// Solves matrices[k] x = rhs[k] in place (one right-hand side each, `count` systems): two at a
+/// time where they share size, bandwidth and pivoting, their rows in turn (the CPU overlaps the
+/// two chains of dependent updates); bit for bit each matrix's own Solve.
+void SolveEach(const BandedMatrix* const* matrices, double* const* rhs, int count);
+
 class BandedMatrix {
  public:
   BandedMatrix() = default;
@@ -65,6 +72,7 @@ class BandedMatrix {
   int Index(int i, int j) const { return (2 * kd_ + i - j) + j * ldab_; }
   // Solve for many right-hand sides at once, on a row-major copy (vectorizes across them).
   void SolveManyRows(double* b, int num_rhs) const;
+  friend void SolveEach(const BandedMatrix* const*, double* const*, int);
 
   int n_ = 0;
   int kd_ = 0;

@@ -4,6 +4,8 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "stokesrods/common/parallel.h"
+
 extern "C" {
 void sgemv_(const char* trans, const int* m, const int* n, const float* alpha, const float* a,
             const int* lda, const float* x, const int* incx, const float* beta, float* y,
@@ -80,9 +82,11 @@ void Gemv(const Eigen::MatrixXf& a, const Eigen::VectorXf& x, Eigen::VectorXf* y
   const Eigen::Index m = a.rows();
   y->resize(m);
   constexpr Eigen::Index kRows = 1024;  // each block's rows: the same sums on any thread count
-#pragma omp parallel for schedule(static) if (m > 2 * kRows)
-  for (Eigen::Index first = 0; first < m; first += kRows)
+  const int blocks = static_cast<int>((m + kRows - 1) / kRows);
+  ForEachStatic(blocks, blocks > 2, [&](int b) {
+    const Eigen::Index first = b * kRows;
     GemvRows(a, first, std::min(kRows, m - first), x.data(), y->data() + first);
+  });
 }
 
 
