@@ -320,8 +320,9 @@ float DecodeHalf(std::uint16_t h) {
 void CheckRoundsToWhatTheHalfValuesStandFor(bool f16c) {
   std::mt19937 random(7);
   std::uniform_real_distribution<float> decade(-7.0f, 2.0f), unit(-1.0f, 1.0f);
-  // (100 003: in two parts over the threads, the largest entry in the second.)
-  for (const int n : {1, 15, 16, 17, 1000, 100003}) {
+  // (kTwoPartsFrom + 3: in two parts over the threads, the largest entry in the second.)
+  const int two_parts = static_cast<int>(kTwoPartsFrom);
+  for (const int n : {1, 15, 16, 17, 1000, two_parts + 3}) {
     std::vector<float> d(static_cast<std::size_t>(n));
     for (float& v : d) v = unit(random) * std::pow(10.0f, decade(random));
     if (n > 2) d[1] = 0.0f;
@@ -351,8 +352,10 @@ void CheckRoundsToWhatTheHalfValuesStandFor(bool f16c) {
   EXPECT_EQ(RoundToHalf(20, zeros.data(), half.data(), f16c), 1.0f);
   EXPECT_EQ(half[19], 0);
   for (const float bad : {NAN, INFINITY}) {
-    // In a whole block of 8 or 16, or in the last entries; of 70 001, in the second part.
-    for (const auto& [n, where] : {std::pair{39, 3}, {39, 33}, {39, 38}, {70001, 70000}}) {
+    // In a whole block of 8 or 16, or in the last entries; of kTwoPartsFrom + 1, in the second
+    // part.
+    for (const auto& [n, where] :
+         {std::pair{39, 3}, {39, 33}, {39, 38}, {two_parts + 1, two_parts}}) {
       std::vector<float> d(static_cast<std::size_t>(n), 1.0f);
       d[static_cast<std::size_t>(where)] = bad;
       std::vector<std::uint16_t> untouched(d.size(), 0x1234);
@@ -363,14 +366,14 @@ void CheckRoundsToWhatTheHalfValuesStandFor(bool f16c) {
   }
 }
 
-// The rounding of a large matrix (two parts over the threads from 2¹⁶ entries) gives the same
-// scale and bits on one thread and on two.
+// The rounding of a large matrix (two parts over the threads from kTwoPartsFrom entries) gives
+// the same scale and bits on one thread and on two.
 TEST(MobilityReuseHalf, RoundsToTheSameBitsOnAnyNumberOfThreads) {
   if (!HasHalfDifferences()) GTEST_SKIP() << "neither AVX-512 BW nor F16C on this CPU";
 #ifdef _OPENMP
   std::mt19937 random(9);
   std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
-  const int n = 9 * 20011;
+  const int n = static_cast<int>(kTwoPartsFrom) + 9 * 20011;
   std::vector<float> before(static_cast<std::size_t>(n));
   for (float& v : before) v = unit(random);
   before[static_cast<std::size_t>(n) - 5] = 7.5f;  // the largest, in the second part
@@ -403,12 +406,12 @@ TEST(MobilityReuseHalf, RoundsToWhatTheHalfValuesStandFor) {
 
 // The extrapolation from half-precision differences is base + a · slope + b · curve on the
 // decoded values, to single precision's rounding of the sum (with and without the curve; n with
-// masked tails), by both kernels.
+// masked tails, and in two parts), by both kernels.
 TEST(MobilityReuseHalf, ExtrapolatesTheDecodedDifferences) {
   if (!HasHalfDifferences()) GTEST_SKIP() << "neither AVX-512 BW nor F16C on this CPU";
   std::mt19937 random(11);
   std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
-  for (const int n : {5, 16, 21, 390 * 390}) {
+  for (const int n : {5, 16, 21, 390 * 390, static_cast<int>(kTwoPartsFrom) + 5}) {
     std::vector<float> base(static_cast<std::size_t>(n)), slope(base), curve(base), out(base);
     for (std::size_t i = 0; i < base.size(); ++i)
       base[i] = unit(random), slope[i] = 1e-2f * unit(random), curve[i] = 1e-4f * unit(random);

@@ -28,6 +28,24 @@ inline bool Parallel(bool worth) {
 #endif
 }
 
+/// From this many nodes (all rods together) on, the loops over the rods at every step (frames,
+/// elastic forces, the banded factors and solves, the preconditioner's rotations) run on the
+/// threads. Below it a region's fork and join cost more than the rods' work it splits: on two
+/// threads paper Fig. 1 (130 nodes) took 0.27 ms a step at h = 1 ms with these loops split,
+/// 0.19–0.21 without; at 260 to 650 nodes splitting them was even or a few percent faster
+/// (AMD EPYC host, docs/performance.md, session 34), and beyond the rods' work grows and the
+/// fork's cost does not.
+inline constexpr int kRodsInParallelFrom = 256;
+
+/// From this many rows on, the dense mobility's passes (its products, the reuse's extrapolation
+/// and rounding) run on the threads. With them split, Fig. 1's step (390 rows) took 0.75 of the
+/// time on two threads; four helices' (780) were even either way, LSBT's (1170: 2 × 195 nodes)
+/// 1.17 times as long serial (the same host, session 34).
+inline constexpr int kDenseInParallelFromRows = 1024;
+
+/// Whether a loop over `rods` rods of `nodes` nodes in all is worth splitting over the threads.
+inline bool RodsInParallel(int rods, int nodes) { return rods > 1 && nodes >= kRodsInParallelFrom; }
+
 /// body(i) for i = 0 … count − 1: in equal runs over the threads (OpenMP's static schedule) where
 /// Parallel(worth), else in order on this thread.
 template <class Body>

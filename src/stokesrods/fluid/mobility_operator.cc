@@ -82,8 +82,8 @@ class DenseMobility final : public MobilityOperator {
   void Apply(const VecX& force, VecX* velocity) const override {
     // Row blocks in parallel: the product streams the whole matrix (memory bound beyond cache).
     // In single precision by blocks of 64 rows dealt out in turn (each row's sum is the same
-    // whatever the blocks: GemvRowsMixed), so that two threads share Fig. 1's 390 rows evenly
-    // (by 192, one took 384 of them); in double by LAPACK's dgemv on fixed blocks of 192.
+    // whatever the blocks: GemvRowsMixed), from kDenseInParallelFromRows rows on
+    // (common/parallel.h); in double by LAPACK's dgemv on fixed blocks of 192.
     const Eigen::Index n = products_ ? products_->rows() : matrix_.rows();
     velocity->resize(n);
     if (products_) {
@@ -92,7 +92,7 @@ class DenseMobility final : public MobilityOperator {
         GemvRowsMixed(*products_, first, std::min(kRows, n - first), force.data(),
                       velocity->data() + first);
       };
-      if (!Parallel(n > 4 * kRows)) {
+      if (!Parallel(n >= kDenseInParallelFromRows)) {
         for (Eigen::Index first = 0; first < n; first += kRows) rows(first);
         return;
       }

@@ -13,8 +13,10 @@ namespace stokesrods {
 /// Whether this CPU runs the functions below: AVX-512 F, BW and VL, or AVX2, FMA and F16C.
 bool HasHalfDifferences();
 
-/// From this many entries on, the passes over the reuse's matrices run in two parts.
-inline constexpr Eigen::Index kTwoPartsFrom = Eigen::Index{1} << 16;
+/// From this many entries on (a matrix of kDenseInParallelFromRows rows, common/parallel.h), the
+/// passes over the reuse's matrices run in two parts.
+inline constexpr Eigen::Index kTwoPartsFrom =
+    Eigen::Index{kDenseInParallelFromRows} * Eigen::Index{kDenseInParallelFromRows};
 
 /// body(part, first, count) over [0, n): in two parts cut at a multiple of 16 (whole vectors) and
 /// run over the OpenMP threads from kTwoPartsFrom entries on (a pass over memory: two cores

@@ -42,7 +42,7 @@ void SolveRodsBanded(const Model& model, const std::vector<BandedMatrix>& jacobi
       SolveEach(matrices, rhs, count);
     }
   };
-  if (!Parallel(num_rods > 1)) return solve(0, num_rods);
+  if (!Parallel(RodsInParallel(num_rods, model.num_nodes))) return solve(0, num_rods);
 #pragma omp parallel
   {
 #ifdef _OPENMP
@@ -206,7 +206,7 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
   SR_ASSERT(!explicit_, "the capacitance solve is for the implicit coupling");
   const int num_rods = static_cast<int>(jacobian->size());
   std::vector<char> regular(jacobian->size());
-  ForEachStatic(num_rods, num_rods > 1, [&](int r) {
+  ForEachStatic(num_rods, RodsInParallel(num_rods, model.num_nodes), [&](int r) {
     regular[static_cast<size_t>(r)] = (*jacobian)[static_cast<size_t>(r)].Factorize();
   });
   if (std::find(regular.begin(), regular.end(), 0) != regular.end()) return false;
@@ -326,7 +326,7 @@ void HydroCoupling::UpdatePreconditionerRotations(const Model& model) {
   RodRotations& q = preconditioner_rotations_;
   q.rotation.resize(positions_.size());
   const int num_rods = static_cast<int>(positions_.size());
-  ForEachStatic(num_rods, num_rods > 1, [&](int ri) {
+  ForEachStatic(num_rods, RodsInParallel(num_rods, model.num_nodes), [&](int ri) {
     const auto r = static_cast<std::size_t>(ri);
     q.rotation[r] = Mat3::Identity();
     // A rod clamped on a body turns with it; its cell's block holds the body's points, which

@@ -106,7 +106,7 @@ void Evaluate(const Model& model, const State& start, double h, const VecX& q,
   std::vector<BandedMatrix>* jac = with_jacobian ? &ws->jacobian : nullptr;
   // Rods in parallel: each writes only its own DOFs of the force and its own banded matrix.
   const int num_rods = static_cast<int>(model.rods.size());
-  ForEachDynamic(num_rods, num_rods > 1, [&](int r) {
+  ForEachDynamic(num_rods, RodsInParallel(num_rods, model.num_nodes), [&](int r) {
     if (jac) (*jac)[static_cast<size_t>(r)].SetZero();
     AddElasticForces(model.rods[static_cast<size_t>(r)], q, (*frames)[static_cast<size_t>(r)],
                      &ws->force, jac ? &(*jac)[static_cast<size_t>(r)] : nullptr);

@@ -32,7 +32,7 @@ void TransportFrames(const Model& model, const VecX& q, const std::vector<RodFra
                      std::vector<RodFrames>* to) {
   to->resize(from.size());
   const int num_rods = static_cast<int>(from.size());
-  ForEachDynamic(num_rods, num_rods > 1, [&](int ri) {
+  ForEachDynamic(num_rods, RodsInParallel(num_rods, model.num_nodes), [&](int ri) {
     const auto r = static_cast<std::size_t>(ri);
     RodFrames& out = (*to)[r];
     out.frames = from[r].frames;
