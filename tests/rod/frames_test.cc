@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 
 #include "stokesrods/rod/geometry.h"
@@ -250,16 +251,28 @@ TEST(FramesTest, TransportFramesAndTwistsOnEachPath) {
               worst_frame, worst_twist);
 }
 
-// Degenerate input fails on the lanes' path as on the portable one, with the same message.
+// Degenerate input fails on the lanes' paths as on the portable one, with the same message: a
+// zero-length edge, and a node that is not a number (on a rod of one edge, which has no twist to
+// betray it).
 TEST(FramesTest, TransportFramesAndTwistsRejectsAZeroEdge) {
   HelixGeometry g;
   g.nodes = 12;
-  Matrix3X x = HelixNodes(g);
-  std::vector<RefFrame> frames = SpaceParallelFrames(x);
-  std::vector<Vec3> tangents = EdgeTangents(x);
-  x.col(6) = x.col(5);
-  VecX twist;
-  EXPECT_DEATH(TransportFramesAndTwists(x, &tangents, &frames, VecX(), &twist), "zero-length edge");
+  const Matrix3X helix = HelixNodes(g);
+  for (const FramePath path : {FramePath::kWidest, FramePath::kAvx2, FramePath::kPortable}) {
+    Matrix3X x = helix;
+    std::vector<RefFrame> frames = SpaceParallelFrames(x);
+    std::vector<Vec3> tangents = EdgeTangents(x);
+    x.col(6) = x.col(5);
+    VecX twist;
+    EXPECT_DEATH(TransportFramesAndTwists(x, &tangents, &frames, VecX(), &twist, path),
+                 "zero-length edge");
+    Matrix3X two = helix.leftCols(2);
+    std::vector<RefFrame> frames2 = SpaceParallelFrames(two);
+    std::vector<Vec3> tangents2 = EdgeTangents(two);
+    two(1, 1) = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_DEATH(TransportFramesAndTwists(two, &tangents2, &frames2, VecX(), &twist, path),
+                 "zero-length edge");
+  }
 }
 
 TEST(MaterialFrame, RotatesTheReferenceFrameByTheta) {

@@ -150,6 +150,9 @@ bool TransportFramesInLanes(const Matrix3X& x_new, std::vector<Vec3>* tangents,
   if (!(c.smallest[0] > 0.0 && c.smallest[1] > 1e-12 && c.smallest[2] > 1e-8)) return false;
   for (std::size_t i = 0; i + 1 < edges; ++i)
     if (!std::isfinite(c.angle[i])) return false;
+  for (std::size_t j = 0; j < edges; ++j)  // a NaN anywhere reaches d1 (the minima skip NaN)
+    for (int k = 0; k < 3; ++k)
+      if (!std::isfinite(c.d1[k][j])) return false;
   for (std::size_t j = 0; j < edges; ++j)
     for (int k = 0; k < 3; ++k) {
       (*tangents)[j][k] = c.tangent[k][j];
