@@ -242,7 +242,8 @@ TEST(FramesTest, TransportFramesAndTwistsOnEachPath) {
         EXPECT_LT(e, 4e-15 + 1e-15 * std::abs(twist_ref[i])) << "nodes " << nodes << " node " << i;
       }
       if (path == FramePath::kPortable) {  // the reference itself, bit for bit
-        for (std::size_t j = 0; j < frames.size(); ++j) EXPECT_EQ(frames_lanes[j].d1, frames_ref[j].d1);
+        for (std::size_t j = 0; j < frames.size(); ++j)
+          EXPECT_EQ(frames_lanes[j].d1, frames_ref[j].d1);
         EXPECT_EQ(twist, twist_ref);
       }
     }

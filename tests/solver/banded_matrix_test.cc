@@ -148,7 +148,8 @@ TEST(BandedMatrix, SolveEachGivesEachMatrixsOwnSolveBitForBit) {
            std::vector<std::vector<int>>{{259, 259}, {259, 259, 259}, {259, 131}, {2, 2}}) {
         std::vector<BandedMatrix> matrices;
         for (const int n : sizes) {
-          matrices.push_back(pivoted ? RandomBanded(n, kd, true, &rng) : DefiniteBanded(n, kd, &rng));
+          matrices.push_back(pivoted ? RandomBanded(n, kd, true, &rng)
+                                     : DefiniteBanded(n, kd, &rng));
           ASSERT_TRUE(matrices.back().Factorize());
           ASSERT_EQ(matrices.back().pivoted(), pivoted);
         }

@@ -26,11 +26,12 @@ void AddStretchingBlocks(int a, int b, const Mat6& h6, BandedMatrix* hessian) {
 
 // The forces, and the Jacobian where `hessian` is given, by edges: each edge's vector, length and
 // material directors are computed once (one sine and one cosine per edge, where the stencils'
-// own calls take two per stencil; several edges per vector: MaterialFrames) into columns, and the bending and twisting of all stencils are
-// then computed several at a time, one per vector lane (elastic/stencil_batch.h; the formulas in
-// elastic/stencil_lanes.h). The arithmetic of StretchingEnergy, BendingEdgeEnergy and
-// TwistingEdgeEnergy otherwise; ElasticAssembly.* (tests/sim/jacobian_test.cc) compares it with
-// AddElasticForcesPerStencil on every instruction set.
+// own calls take two per stencil; several edges per vector: MaterialFrames) into columns, and
+// the bending and twisting of all stencils are then computed several at a time, one per vector
+// lane (elastic/stencil_batch.h; the formulas in elastic/stencil_lanes.h). The arithmetic of
+// StretchingEnergy, BendingEdgeEnergy and TwistingEdgeEnergy otherwise; ElasticAssembly.*
+// (tests/sim/jacobian_test.cc) compares it with AddElasticForcesPerStencil on every instruction
+// set.
 double AddElasticForcesByEdge(const RodModel& rod, const VecX& q, const RodFrames& frames,
                               VecX* force, BandedMatrix* hessian, StencilPath path) {
   const int n = rod.num_nodes();
@@ -54,7 +55,8 @@ double AddElasticForcesByEdge(const RodModel& rod, const VecX& q, const RodFrame
   for (int j = 0; j + 1 < n; ++j) {
     const RefFrame& f = frames.frames[static_cast<size_t>(j)];
     edge_column(kTheta)[j] = q(o + TwistDof(j));
-    for (int c = 0; c < 3; ++c) edge_column(kD1 + c)[j] = f.d1[c], edge_column(kD2 + c)[j] = f.d2[c];
+    for (int c = 0; c < 3; ++c)
+      edge_column(kD1 + c)[j] = f.d1[c], edge_column(kD2 + c)[j] = f.d2[c];
   }
   for (int c = 0; c < 3; ++c) {
     material.d1[c] = edge_column(kD1 + c);

@@ -260,7 +260,8 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
 void HydroCoupling::BuildSchurBlocks(const Model& model) {
   sx_blocks_.resize(model.rods.size());
   const int num_rods = static_cast<int>(model.rods.size());
-  ForEachDynamic(num_rods, num_rods > 1, [&](int ri) {  // each rod's own block (and its borders' rows)
+  // Each rod's own block (and its borders' rows).
+  ForEachDynamic(num_rods, num_rods > 1, [&](int ri) {
     const auto r = static_cast<std::size_t>(ri);
     const RodModel& rod = model.rods[r];
     const int n = rod.num_nodes();
