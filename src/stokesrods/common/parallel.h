@@ -38,9 +38,9 @@ inline bool Parallel(bool worth) {
 inline constexpr int kRodsInParallelFrom = 256;
 
 /// From this many rows on, the dense mobility's passes (its products, the reuse's extrapolation
-/// and rounding) run on the threads. With them split, Fig. 1's step (390 rows) took 0.75 of the
-/// time on two threads; four helices' (780) were even either way, LSBT's (1170: 2 × 195 nodes)
-/// 1.17 times as long serial (the same host, session 34).
+/// and rounding) run on the threads. Split, they made Fig. 1's step (390 rows) slower on two
+/// threads than on one; four helices' (780) were even either way; LSBT's 1170 rows (2 × 195
+/// nodes) stay split, where serial looked slower but within the host's noise (session 34).
 inline constexpr int kDenseInParallelFromRows = 1024;
 
 /// Whether a loop over `rods` rods of `nodes` nodes in all is worth splitting over the threads.
