@@ -11,6 +11,22 @@
 #include "stokesrods/rod/frames.h"
 
 namespace stokesrods {
+#if defined(__x86_64__)
+namespace {
+
+enum class Lanes { kAvx512, kAvx2, kOne };
+
+// The lanes `path` asks for that the CPU has.
+Lanes LanesFor(StencilPath path) {
+  static const bool has_avx512 = __builtin_cpu_supports("avx512f");
+  static const bool has_avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  if (path == StencilPath::kWidest && has_avx512) return Lanes::kAvx512;
+  if (path != StencilPath::kPortable && has_avx2) return Lanes::kAvx2;
+  return Lanes::kOne;
+}
+
+}  // namespace
+#endif
 
 void BendTwistStencils(const StencilColumns& in, int count, bool with_jacobian,
                        StencilResults* out, StencilPath path) {
@@ -21,11 +37,10 @@ void BendTwistStencils(const StencilColumns& in, int count, bool with_jacobian,
   double* const gradient = out->gradient.data();
   double* const jacobian = with_jacobian ? out->jacobian.data() : nullptr;
 #if defined(__x86_64__)
-  static const bool has_avx512 = __builtin_cpu_supports("avx512f");
-  static const bool has_avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  if (path == StencilPath::kWidest && has_avx512)
+  const Lanes lanes = LanesFor(path);
+  if (lanes == Lanes::kAvx512)
     return BendTwistStencilsAvx512(in, count, with_jacobian, energy, gradient, jacobian);
-  if (path != StencilPath::kPortable && has_avx2)
+  if (lanes == Lanes::kAvx2)
     return BendTwistStencilsAvx2(in, count, with_jacobian, energy, gradient, jacobian);
 #endif
   StencilBatches<double, 1>(in, count, with_jacobian, energy, gradient, jacobian);
@@ -33,10 +48,9 @@ void BendTwistStencils(const StencilColumns& in, int count, bool with_jacobian,
 
 void MaterialFrames(const MaterialFrameColumns& frames, int count, StencilPath path) {
 #if defined(__x86_64__)
-  static const bool has_avx512 = __builtin_cpu_supports("avx512f");
-  static const bool has_avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  if (path == StencilPath::kWidest && has_avx512) return MaterialFramesAvx512(frames, count);
-  if (path != StencilPath::kPortable && has_avx2) return MaterialFramesAvx2(frames, count);
+  const Lanes lanes = LanesFor(path);
+  if (lanes == Lanes::kAvx512) return MaterialFramesAvx512(frames, count);
+  if (lanes == Lanes::kAvx2) return MaterialFramesAvx2(frames, count);
 #endif
   for (int j = 0; j < count; ++j) {
     const RefFrame f{Vec3(frames.d1[0][j], frames.d1[1][j], frames.d1[2][j]),

@@ -101,15 +101,11 @@ class DenseMobility final : public MobilityOperator {
       return;
     }
     constexpr Eigen::Index kRows = 192;
-    const auto rows = [&](Eigen::Index first) {
+    const auto blocks = static_cast<int>((n + kRows - 1) / kRows);
+    ForEachStatic(blocks, blocks > 2, [&](int b) {
+      const Eigen::Index first = b * kRows;
       GemvRows(matrix_, first, std::min(kRows, n - first), force.data(), velocity->data() + first);
-    };
-    if (!Parallel(n > 2 * kRows)) {
-      for (Eigen::Index first = 0; first < n; first += kRows) rows(first);
-      return;
-    }
-#pragma omp parallel for schedule(static)
-    for (Eigen::Index first = 0; first < n; first += kRows) rows(first);
+    });
   }
   MatX SelfBlock(int rod) const override {
     const int first = 3 * node_offset(rod), n = 3 * (node_offset(rod + 1) - node_offset(rod));

@@ -1,6 +1,7 @@
 #include "stokesrods/sim/hydro_coupling.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 
@@ -205,11 +206,12 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
                                           std::vector<ClampBorder>* borders) {
   SR_ASSERT(!explicit_, "the capacitance solve is for the implicit coupling");
   const int num_rods = static_cast<int>(jacobian->size());
-  std::vector<char> regular(jacobian->size());
+  std::atomic<bool> regular{true};
   ForEachStatic(num_rods, RodsInParallel(num_rods, model.num_nodes), [&](int r) {
-    regular[static_cast<size_t>(r)] = (*jacobian)[static_cast<size_t>(r)].Factorize();
+    if (!(*jacobian)[static_cast<size_t>(r)].Factorize())
+      regular.store(false, std::memory_order_relaxed);
   });
-  if (std::find(regular.begin(), regular.end(), 0) != regular.end()) return false;
+  if (!regular.load(std::memory_order_relaxed)) return false;
   jacobian_ = jacobian;
   borders_ = borders;
   if (borders) CompleteClampBorders(model, *jacobian, borders);
