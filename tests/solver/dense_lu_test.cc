@@ -61,7 +61,7 @@ struct LuKernels {
   const char* name;
   void (*solve)(int, const float*, const int*, float*);
   bool (*to_half)(int, const float*, std::uint16_t*, float*);
-  void (*solve_half)(int, const std::uint16_t*, const int*, float, float*);
+  void (*solve_half)(int, const std::uint16_t*, const int*, float, float*, PrefetchSpan);
   bool half;  // whether the CPU runs to_half and solve_half
 };
 std::vector<LuKernels> KernelsHere() {
@@ -175,7 +175,7 @@ TEST(DenseLu, TheBlockedSingleSolveDoesNotDependOnTheThreadCount) {
       omp_set_num_threads(threads);
       kernel.solve(n, factors.data(), pivots.data(), x[threads - 1].data());
       if (kernel.half)
-        kernel.solve_half(n, half.data(), pivots.data(), scale, x_half[threads - 1].data());
+        kernel.solve_half(n, half.data(), pivots.data(), scale, x_half[threads - 1].data(), {});
     }
     EXPECT_TRUE(x[0] == x[1]) << kernel.name;
     EXPECT_TRUE(x_half[0] == x_half[1]) << kernel.name;
@@ -212,9 +212,11 @@ TEST(DenseLu, HalfPrecisionFactorsSolveLikeTheirSinglePrecisionValues) {
     ASSERT_TRUE(half.Compute(a, LuStorage::kHalf));
     EXPECT_FALSE(single.half());
     ASSERT_TRUE(half.half());
-    Eigen::VectorXf x_single = b, x_half = b;
+    Eigen::VectorXf x_single = b, x_half = b, x_then = b;
     single.Solve(&x_single);
     half.Solve(&x_half);
+    half.SolveThenPrefetch(&x_then, single);
+    EXPECT_EQ(x_then, x_half) << n;
     const float difference = (x_half - x_single).norm() / x_single.norm();
     EXPECT_LT(difference, 1e-3f) << n;
     if (n > 1) {
@@ -232,7 +234,12 @@ TEST(DenseLu, HalfPrecisionFactorsSolveLikeTheirSinglePrecisionValues) {
       if (first.empty()) first = rounded;
       EXPECT_TRUE(rounded == first) << kernel.name << " " << n;
       Eigen::VectorXf x_kernel = b;
-      kernel.solve_half(n, rounded.data(), pivots.data(), scale, x_kernel.data());
+      kernel.solve_half(n, rounded.data(), pivots.data(), scale, x_kernel.data(), {});
+      // Prefetching another span along the way (SolveThenPrefetch) changes nothing.
+      Eigen::VectorXf x_prefetching = b;
+      kernel.solve_half(n, rounded.data(), pivots.data(), scale, x_prefetching.data(),
+                        {reinterpret_cast<const char*>(first.data()), 2 * first.size()});
+      EXPECT_EQ(x_prefetching, x_kernel) << kernel.name << " " << n;
       // The reference: the same rounded factors, widened, through the single-precision kernel.
       Eigen::MatrixXf widened(n, n);
       for (int j = 0; j < n; ++j)

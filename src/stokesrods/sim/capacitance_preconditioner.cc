@@ -192,15 +192,20 @@ bool CapacitancePreconditioner::BuildFreeBody(const Model& model, double h, int 
 void CapacitancePreconditioner::SolveBlocks(const VecX& v, VecX* out) const {
   out->setZero(v.size());
   const int num_blocks = static_cast<int>(blocks_.size());
-  // A rod's factors take 150 KB (65 nodes), 15 MB for a hundred rods: more than the caches, so
-  // each application streams them from memory. Each thread takes consecutive blocks (static) and
-  // prefetches the next one's factors before it solves one: on 100 helices the solves and the
-  // prefetches together take 0.82 of the solves' time without (docs/performance.md, "Session 13").
+  // A rod's factors take 76 KB in half precision (65 nodes), 7.6 MB for a hundred rods: more
+  // than the caches keep between applications, so each streams them from memory. Each thread
+  // takes consecutive blocks (static) and, while it solves one, brings the next one's factors
+  // into L2 a little at a time (DenseLu::SolveThenPrefetch): a hundred blocks of 195, one thread,
+  // from memory, 10.9 µs a block with the next one prefetched at once before each solve, 8.8
+  // spread over it, 6.3 from cache (bench_step BM_BlockSolvesCold; docs/performance.md, session
+  // 35; before session 13 without any prefetch, 1.2× slower).
   ForEachStatic(num_blocks, num_blocks > 1, [&](int k) {  // the blocks' entries are disjoint
     const Block& block = blocks_[static_cast<size_t>(k)];
-    if (k + 1 < num_blocks) blocks_[static_cast<size_t>(k) + 1].lu.Prefetch();
     Eigen::VectorXf x = block.Gather(v).cast<float>();
-    block.lu.Solve(&x);
+    if (k + 1 < num_blocks)
+      block.lu.SolveThenPrefetch(&x, blocks_[static_cast<size_t>(k) + 1].lu);
+    else
+      block.lu.Solve(&x);
     block.Scatter(x.cast<double>(), out);
   });
 }

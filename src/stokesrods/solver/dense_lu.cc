@@ -176,6 +176,26 @@ void DenseLu<Scalar>::Solve(Vector* b, bool use_lapack) const {
 }
 
 template <typename Scalar>
+void DenseLu<Scalar>::SolveThenPrefetch(Vector* b, const DenseLu& next) const {
+  if constexpr (std::is_same_v<Scalar, float>) {
+    const int n = static_cast<int>(n_);
+    if (!half_.empty() && n > 0 && n < kParallelLuSolve) {
+      SR_ASSERT(b->size() == n_, "DenseLu: right-hand side of the wrong size");
+      const PrefetchSpan then = next.half_.empty()
+          ? PrefetchSpan{reinterpret_cast<const char*>(next.lu_.data()),
+                         sizeof(Scalar) * static_cast<std::size_t>(next.lu_.size())}
+          : PrefetchSpan{reinterpret_cast<const char*>(next.half_.data()),
+                         sizeof(std::uint16_t) * next.half_.size()};
+      if (HasLuSolveHalfAvx512())
+        return LuSolveHalfAvx512(n, half_.data(), pivots_.data(), half_scale_, b->data(), then);
+      return LuSolveHalfAvx2(n, half_.data(), pivots_.data(), half_scale_, b->data(), then);
+    }
+  }
+  next.Prefetch();
+  Solve(b);
+}
+
+template <typename Scalar>
 void DenseLu<Scalar>::Prefetch() const {
   const char* p = half_.empty() ? reinterpret_cast<const char*>(lu_.data())
                                 : reinterpret_cast<const char*>(half_.data());

@@ -49,6 +49,10 @@ class DenseLu {
   /// `use_lapack` forces getrs (tests). Factors in half precision are always solved by their own
   /// kernel (lu_solve_avx512.h).
   void Solve(Vector* b, bool use_lapack = false) const;
+  /// Solve, bringing `next`'s factors into the L2 cache a little at a time along the way (a
+  /// sequence of solves whose factors stream from memory: half precision below
+  /// kParallelLuSolve; else `next`.Prefetch() first). The same x as Solve.
+  void SolveThenPrefetch(Vector* b, const DenseLu& next) const;
   Eigen::Index size() const { return n_; }
   /// Asks the CPU to bring the factors into its L2 cache ahead of a Solve (no effect on results).
   void Prefetch() const;

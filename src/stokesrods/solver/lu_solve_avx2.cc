@@ -111,6 +111,51 @@ SR_AVX2_INLINE void SubtractColumns(int rows, int cols, const E* p, Eigen::Index
   for (; j < cols; ++j) AxpyShort(rows, p + j * ld, x[j], y);
 }
 
+// A tile's chunk (LuPanels: column-major, leading dimension `rows`, consecutive memory): y[0,
+// rows) −= Σ_j x_j p(:, j), 64 rows at a time in eight accumulators over all the chunk's columns,
+// the next columns prefetched ahead (the first pass brings in whole columns; the later passes
+// find them in cache); the rows past the last 64 by SubtractColumns. Each row's operations are
+// SubtractColumns' in its order (the same bits), and those of the AVX-512 SubtractChunkHalf.
+template <class E>
+SR_AVX2_INLINE void SubtractChunk(int rows, int cols, const E* p, const float* x, float* y) {
+  constexpr int kPrefetchColumns = 16;  // as the AVX-512 kernel's (4 KB of halves ahead)
+  const std::ptrdiff_t column_bytes = static_cast<std::ptrdiff_t>(rows) * sizeof(E);
+  int i0 = 0;
+  for (; i0 + 64 <= rows; i0 += 64) {
+    float* out = y + i0;
+    __m256 a0 = _mm256_loadu_ps(out), a1 = _mm256_loadu_ps(out + 8),
+           a2 = _mm256_loadu_ps(out + 16), a3 = _mm256_loadu_ps(out + 24),
+           a4 = _mm256_loadu_ps(out + 32), a5 = _mm256_loadu_ps(out + 40),
+           a6 = _mm256_loadu_ps(out + 48), a7 = _mm256_loadu_ps(out + 56);
+    for (int j = 0; j < cols; ++j) {
+      const E* column = p + static_cast<std::ptrdiff_t>(j) * rows;
+      if (i0 == 0) {
+        const char* ahead = reinterpret_cast<const char*>(column + kPrefetchColumns * rows);
+        for (std::ptrdiff_t b = 0; b < column_bytes; b += 64) _mm_prefetch(ahead + b, _MM_HINT_T0);
+      }
+      const __m256 xj = _mm256_set1_ps(x[j]);
+      const E* c = column + i0;
+      a0 = _mm256_fnmadd_ps(Load8(c), xj, a0);
+      a1 = _mm256_fnmadd_ps(Load8(c + 8), xj, a1);
+      a2 = _mm256_fnmadd_ps(Load8(c + 16), xj, a2);
+      a3 = _mm256_fnmadd_ps(Load8(c + 24), xj, a3);
+      a4 = _mm256_fnmadd_ps(Load8(c + 32), xj, a4);
+      a5 = _mm256_fnmadd_ps(Load8(c + 40), xj, a5);
+      a6 = _mm256_fnmadd_ps(Load8(c + 48), xj, a6);
+      a7 = _mm256_fnmadd_ps(Load8(c + 56), xj, a7);
+    }
+    _mm256_storeu_ps(out, a0);
+    _mm256_storeu_ps(out + 8, a1);
+    _mm256_storeu_ps(out + 16, a2);
+    _mm256_storeu_ps(out + 24, a3);
+    _mm256_storeu_ps(out + 32, a4);
+    _mm256_storeu_ps(out + 40, a5);
+    _mm256_storeu_ps(out + 48, a6);
+    _mm256_storeu_ps(out + 56, a7);
+  }
+  if (i0 < rows) SubtractColumns(rows - i0, cols, p + i0, rows, x, y + i0);
+}
+
 // U's factors in half precision are scaled by u_scale: U' x = u_scale y.
 template <class E>
 SR_AVX2_INLINE void ScaleForU(int n, float u_scale, float* x) {
@@ -142,6 +187,10 @@ SR_AVX2_CALLED void SubtractColumnsCalled(int rows, int cols, const E* p, Eigen:
   SubtractColumns(rows, cols, p, ld, x, y);
 }
 template <class E>
+SR_AVX2_CALLED void SubtractChunkCalled(int rows, int cols, const E* p, const float* x, float* y) {
+  SubtractChunk(rows, cols, p, x, y);
+}
+template <class E>
 SR_AVX2_CALLED void ScaleForUCalled(int n, float u_scale, float* x) {
   ScaleForU<E>(n, u_scale, x);
 }
@@ -162,8 +211,11 @@ SR_AVX2 void LuSolveParallel(int n, const E* lu, const int* pivots, float u_scal
 #pragma omp for schedule(static)
       for (int r = j1; r < n; r += kLuChunkRows) {
         const int rows = std::min(kLuChunkRows, n - r);
-        SubtractColumnsCalled(rows, w, lu + panels.LowerChunk(j0, j1, r), panels.ChunkStride(rows),
-                              x + j0, x + r);
+        if (panels.tiled)  // consecutive chunks
+          SubtractChunkCalled(rows, w, lu + panels.LowerChunk(j0, j1, r), x + j0, x + r);
+        else
+          SubtractColumnsCalled(rows, w, lu + panels.LowerChunk(j0, j1, r),
+                                panels.ChunkStride(rows), x + j0, x + r);
       }
     }
 #pragma omp single
@@ -175,27 +227,34 @@ SR_AVX2 void LuSolveParallel(int n, const E* lu, const int* pivots, float u_scal
 #pragma omp for schedule(static)
       for (int r = 0; r < j0; r += kLuChunkRows) {
         const int rows = std::min(kLuChunkRows, j0 - r);
-        SubtractColumnsCalled(rows, w, lu + panels.UpperChunk(j0, j1, r), panels.ChunkStride(rows),
-                              x + j0, x + r);
+        if (panels.tiled)  // consecutive chunks
+          SubtractChunkCalled(rows, w, lu + panels.UpperChunk(j0, j1, r), x + j0, x + r);
+        else
+          SubtractColumnsCalled(rows, w, lu + panels.UpperChunk(j0, j1, r),
+                                panels.ChunkStride(rows), x + j0, x + r);
       }
     }
   }
 }
 
 template <class E>
-SR_AVX2 void LuSolve(int n, const E* lu, const int* pivots, float u_scale, float* x) {
+SR_AVX2 void LuSolve(int n, const E* lu, const int* pivots, float u_scale, float* x,
+                     PrefetchSpan then = {}) {
   if (n >= kParallelLuSolve) return LuSolveParallel(n, lu, pivots, u_scale, x);
+  SpreadPrefetch spread(then, 2 * ((n + kLuBlock - 1) / kLuBlock));
   for (int i = 0; i < n; ++i)
     if (pivots[i] - 1 != i) std::swap(x[i], x[pivots[i] - 1]);
   const Eigen::Index ld = n;
   for (int j0 = 0; j0 < n; j0 += kLuBlock) {  // L (unit diagonal), blocks from the top
     const int j1 = std::min(j0 + kLuBlock, n);
+    spread.Next();
     LowerTriangle(j1 - j0, lu + j0 + j0 * ld, ld, x + j0);
     SubtractPanel(n - j1, j1 - j0, lu + j1 + j0 * ld, ld, x + j0, x + j1);
   }
   ScaleForU<E>(n, u_scale, x);
   for (int j1 = n; j1 > 0; j1 -= kLuBlock) {  // U, blocks from the bottom
     const int j0 = std::max(j1 - kLuBlock, 0);
+    spread.Next();
     UpperTriangle(j1 - j0, lu + j0 + j0 * ld, ld, x + j0);
     SubtractPanel(j0, j1 - j0, lu + j0 * ld, ld, x + j0, x);
   }
@@ -208,8 +267,8 @@ void LuSolveAvx2(int n, const float* lu, const int* pivots, float* x) {
 }
 
 void LuSolveHalfAvx2(int n, const std::uint16_t* half, const int* pivots, float u_scale,
-                     float* x) {
-  LuSolve(n, half, pivots, u_scale, x);
+                     float* x, PrefetchSpan then) {
+  LuSolve(n, half, pivots, u_scale, x, then);
 }
 
 SR_AVX2 bool RoundLuToHalfF16c(int n, const float* lu, std::uint16_t* half, float* u_scale) {

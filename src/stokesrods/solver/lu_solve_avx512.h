@@ -3,10 +3,36 @@
 // DenseLu<float>::Solve uses the widest the CPU has.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 
 namespace stokesrods {
+
+/// Memory a solve brings into the L2 cache a little at a time while it works (the factors of the
+/// next solve of a sequence: SolveBlocks' rods), instead of all at once before it: a burst of
+/// prefetches fills the CPU's queue of misses and then waits on it. Empty: none.
+struct PrefetchSpan {
+  const char* first = nullptr;
+  std::size_t bytes = 0;
+};
+/// A PrefetchSpan spread over `steps` calls of Next(), each asking for its next share of the
+/// span's cache lines (prefetcht1: into L2).
+class SpreadPrefetch {
+ public:
+  SpreadPrefetch(PrefetchSpan span, int steps)
+      : span_(span), share_(steps > 0 ? (span.bytes + static_cast<std::size_t>(steps) - 1) /
+                                            static_cast<std::size_t>(steps)
+                                      : span.bytes) {}
+  void Next() {
+    const std::size_t stop = std::min(done_ + share_, span_.bytes);
+    for (; done_ < stop; done_ += 64) __builtin_prefetch(span_.first + done_, 0, 2);
+  }
+
+ private:
+  PrefetchSpan span_;
+  std::size_t share_ = 0, done_ = 0;
+};
 
 /// The blocking of both: the small triangles of kLuBlock columns, then the rows below or above
 /// by the block's panel; from n = kParallelLuSolve blocks of kLuWideBlock columns, the rows in
@@ -105,8 +131,9 @@ bool ConvertLuToHalf(int n, const float* lu, std::uint16_t* half, float* u_scale
 /// x ← A⁻¹ x from ConvertLuToHalf's factors: the substitution of LuSolveAvx512, each entry
 /// widened to single precision as it is read (the arithmetic stays single): LuSolveAvx512 on the
 /// rounded factors, to single-precision rounding. Precondition: HasLuSolveHalfAvx512().
+/// `then`: prefetched along the way (below kParallelLuSolve).
 void LuSolveHalfAvx512(int n, const std::uint16_t* half, const int* pivots, float u_scale,
-                       float* x);
+                       float* x, PrefetchSpan then = {});
 /// True when the CPU has AVX-512 F, BW and VL (and so F16C): the half precision loads.
 bool HasLuSolveHalfAvx512();
 
@@ -121,7 +148,8 @@ bool ConvertLuToHalfF16c(int n, const float* lu, std::uint16_t* half, float* u_s
 /// lu_layout.cc). Preconditions as theirs.
 bool RoundLuToHalfAvx512(int n, const float* lu, std::uint16_t* half, float* u_scale);
 bool RoundLuToHalfF16c(int n, const float* lu, std::uint16_t* half, float* u_scale);
-void LuSolveHalfAvx2(int n, const std::uint16_t* half, const int* pivots, float u_scale, float* x);
+void LuSolveHalfAvx2(int n, const std::uint16_t* half, const int* pivots, float u_scale, float* x,
+                     PrefetchSpan then = {});
 /// True when the CPU has AVX2, FMA and F16C.
 bool HasLuSolveAvx2();
 
