@@ -224,7 +224,14 @@ bool CoarseLevel::BuildWith(const std::vector<CoarseRod>& rods, const std::vecto
   // corrected to the nodes' own Stokeslets where a node is near the point.
   // Built with the preconditioner (kept up to 40 steps of ~4 GMRES products), applied once per
   // product: 40 Applies per Build is what a preconditioner rebuilt every 10 steps would see.
-  between_ = MakeFastStokesletSum({.tolerance = 1e-3, .applies_per_build = 40.0});
+  // Summed directly below kCoarseDirectBelowPairs: on a hundred helices (800 points, 6500 nodes,
+  // 5.2 M pairs) the FMM's model put its tree at 0.92 of the direct sum's cost, and alone
+  // (bench_stokeslet_sum BM_CentroidSum) the two took 1.19 and 1.20 ms, but within a step, where
+  // its translations come from memory at every application, 1.78 against 1.25 ms (one thread,
+  // session 35). Above, the model decides (not measured beyond a hundred helices).
+  between_ = MakeFastStokesletSum({.tolerance = 1e-3,
+                                   .direct_below_pairs = kCoarseDirectBelowPairs,
+                                   .applies_per_build = 40.0});
   between_->Build(points_, point_eps_, Matrix3X(x));
   FindNearPoints<K>(x);
 

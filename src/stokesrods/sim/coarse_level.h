@@ -28,6 +28,7 @@
 // diagonal, which keeps E regular and leaves such a turn at zero.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -86,6 +87,8 @@ class CoarseLevel {
   /// E's turn diagonal plus this share of its chunk's force diagonal (a chunk on a line has a
   /// turn of zero force: Build).
   static constexpr float kTurnRegularization = 1e-3f;
+  /// W's sum between rods is direct below this many (point, node) pairs (BuildWith).
+  static constexpr std::int64_t kCoarseDirectBelowPairs = 8'000'000;
   /// Build and FindNearPoints with K modes per chunk (fixed-size blocks: 3 or 6).
   template <int K>
   bool BuildWith(const std::vector<CoarseRod>& rods, const std::vector<MatX>& blocks);
