@@ -158,11 +158,7 @@ void DenseLu<Scalar>::Solve(Vector* b, bool use_lapack) const {
   const int n = static_cast<int>(n_);
   if (n == 0) return;
   if constexpr (std::is_same_v<Scalar, float>) {
-    if (!half_.empty()) {
-      if (HasLuSolveHalfAvx512())
-        return LuSolveHalfAvx512(n, half_.data(), pivots_.data(), half_scale_, b->data());
-      return LuSolveHalfAvx2(n, half_.data(), pivots_.data(), half_scale_, b->data());
-    }
+    if (!half_.empty()) return SolveHalf(b, {});
     if (!use_lapack && HasLuSolveAvx512())
       return LuSolveAvx512(n, lu_.data(), pivots_.data(), b->data());
     // On AVX2 getrs is faster from the parallel panels' size on (bench_step BM_FloatLuSolve, an
@@ -176,32 +172,37 @@ void DenseLu<Scalar>::Solve(Vector* b, bool use_lapack) const {
 }
 
 template <typename Scalar>
-void DenseLu<Scalar>::SolveThenPrefetch(Vector* b, const DenseLu& next) const {
+void DenseLu<Scalar>::SolveHalf(Vector* b, PrefetchSpan then) const {
   if constexpr (std::is_same_v<Scalar, float>) {
     const int n = static_cast<int>(n_);
-    if (!half_.empty() && n > 0 && n < kParallelLuSolve) {
-      SR_ASSERT(b->size() == n_, "DenseLu: right-hand side of the wrong size");
-      const PrefetchSpan then = next.half_.empty()
-          ? PrefetchSpan{reinterpret_cast<const char*>(next.lu_.data()),
-                         sizeof(Scalar) * static_cast<std::size_t>(next.lu_.size())}
-          : PrefetchSpan{reinterpret_cast<const char*>(next.half_.data()),
-                         sizeof(std::uint16_t) * next.half_.size()};
-      if (HasLuSolveHalfAvx512())
-        return LuSolveHalfAvx512(n, half_.data(), pivots_.data(), half_scale_, b->data(), then);
-      return LuSolveHalfAvx2(n, half_.data(), pivots_.data(), half_scale_, b->data(), then);
-    }
+    if (HasLuSolveHalfAvx512())
+      return LuSolveHalfAvx512(n, half_.data(), pivots_.data(), half_scale_, b->data(), then);
+    return LuSolveHalfAvx2(n, half_.data(), pivots_.data(), half_scale_, b->data(), then);
   }
-  next.Prefetch();
-  Solve(b);
+}
+
+template <typename Scalar>
+void DenseLu<Scalar>::SolveThenPrefetch(Vector* b, const DenseLu& next) const {
+  if (half_.empty() || n_ >= kParallelLuSolve) {  // the solve would not spread it
+    next.Prefetch();
+    return Solve(b);
+  }
+  SR_ASSERT(b->size() == n_, "DenseLu: right-hand side of the wrong size");
+  SolveHalf(b, next.FactorBytes());
+}
+
+template <typename Scalar>
+PrefetchSpan DenseLu<Scalar>::FactorBytes() const {
+  return half_.empty() ? PrefetchSpan{reinterpret_cast<const char*>(lu_.data()),
+                                      sizeof(Scalar) * static_cast<std::size_t>(lu_.size())}
+                       : PrefetchSpan{reinterpret_cast<const char*>(half_.data()),
+                                      sizeof(std::uint16_t) * half_.size()};
 }
 
 template <typename Scalar>
 void DenseLu<Scalar>::Prefetch() const {
-  const char* p = half_.empty() ? reinterpret_cast<const char*>(lu_.data())
-                                : reinterpret_cast<const char*>(half_.data());
-  const std::size_t bytes = half_.empty() ? sizeof(Scalar) * static_cast<std::size_t>(lu_.size())
-                                          : sizeof(std::uint16_t) * half_.size();
-  for (std::size_t b = 0; b < bytes; b += 64) __builtin_prefetch(p + b, 0, 2);
+  const PrefetchSpan span = FactorBytes();
+  for (std::size_t b = 0; b < span.bytes; b += 64) __builtin_prefetch(span.first + b, 0, 2);
 }
 
 template class DenseLu<float>;

@@ -11,6 +11,8 @@
 
 #include <Eigen/Core>
 
+#include "stokesrods/solver/lu_solve_avx512.h"
+
 namespace stokesrods {
 
 /// How DenseLu<float> keeps its factors for the solves.
@@ -58,6 +60,10 @@ class DenseLu {
   void Prefetch() const;
 
  private:
+  /// The half-precision kernel of the CPU (kHalf factors), `then` prefetched along the way.
+  void SolveHalf(Vector* b, PrefetchSpan then) const;
+  /// Where the factors the solves read are (half_ or lu_).
+  PrefetchSpan FactorBytes() const;
   Matrix lu_;  ///< empty when the factors are in half_
   std::vector<int> pivots_;
   Eigen::Index n_ = 0;

@@ -120,20 +120,21 @@ __attribute__((target("avx512f"))) void LuSolveAvx512Parallel(int n, const float
 #pragma GCC diagnostic ignored "-Wuninitialized"
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
-SR_F __mmask16 FirstLanes(int count) {
+SR_F __mmask16 Lanes(int count) {  // the first min(count, 16) lanes, none if count ≤ 0
   return static_cast<__mmask16>((1u << std::clamp(count, 0, 16)) - 1u);
 }
-SR_F __m512 LaneOfFloat(__m512 v0, __m512 v1, int k) {
+// Lane k of the 32 floats v0, v1 in every lane (the half kernels below take it too).
+SR_F __m512 LaneOf(__m512 v0, __m512 v1, int k) {
   return _mm512_permutexvar_ps(_mm512_set1_epi32(k & 15), k < 16 ? v0 : v1);
 }
 SR_F void LowerTriangle(int w, const float* d, Eigen::Index ld, float* x) {
-  const __mmask16 rows0 = FirstLanes(w), rows1 = FirstLanes(w - 16);
+  const __mmask16 rows0 = Lanes(w), rows1 = Lanes(w - 16);
   __m512 v0 = _mm512_maskz_loadu_ps(rows0, x), v1 = _mm512_maskz_loadu_ps(rows1, x + 16);
   for (int k = 0; k + 1 < w; ++k) {
-    const __m512 xk = LaneOfFloat(v0, v1, k);
+    const __m512 xk = LaneOf(v0, v1, k);
     const float* column = d + k * ld;
-    const auto below0 = static_cast<__mmask16>(rows0 & ~FirstLanes(k + 1)),
-               below1 = static_cast<__mmask16>(rows1 & ~FirstLanes(k - 15));
+    const auto below0 = static_cast<__mmask16>(rows0 & ~Lanes(k + 1)),
+               below1 = static_cast<__mmask16>(rows1 & ~Lanes(k - 15));
     v0 = _mm512_mask3_fnmadd_ps(_mm512_maskz_loadu_ps(below0, column), xk, v0, below0);
     v1 = _mm512_mask3_fnmadd_ps(_mm512_maskz_loadu_ps(below1, column + 16), xk, v1, below1);
   }
@@ -141,16 +142,16 @@ SR_F void LowerTriangle(int w, const float* d, Eigen::Index ld, float* x) {
   _mm512_mask_storeu_ps(x + 16, rows1, v1);
 }
 SR_F void UpperTriangle(int w, const float* d, Eigen::Index ld, float* x) {
-  const __mmask16 rows0 = FirstLanes(w), rows1 = FirstLanes(w - 16);
+  const __mmask16 rows0 = Lanes(w), rows1 = Lanes(w - 16);
   __m512 v0 = _mm512_maskz_loadu_ps(rows0, x), v1 = _mm512_maskz_loadu_ps(rows1, x + 16);
   for (int k = w - 1; k >= 0; --k) {
     const float* column = d + k * ld;
-    const __m512 xk = _mm512_div_ps(LaneOfFloat(v0, v1, k), _mm512_set1_ps(column[k]));
+    const __m512 xk = _mm512_div_ps(LaneOf(v0, v1, k), _mm512_set1_ps(column[k]));
     if (k < 16)
       v0 = _mm512_mask_mov_ps(v0, static_cast<__mmask16>(1u << k), xk);
     else
       v1 = _mm512_mask_mov_ps(v1, static_cast<__mmask16>(1u << (k - 16)), xk);
-    const __mmask16 above0 = FirstLanes(k), above1 = FirstLanes(k - 16);
+    const __mmask16 above0 = Lanes(k), above1 = Lanes(k - 16);
     v0 = _mm512_mask3_fnmadd_ps(_mm512_maskz_loadu_ps(above0, column), xk, v0, above0);
     v1 = _mm512_mask3_fnmadd_ps(_mm512_maskz_loadu_ps(above1, column + 16), xk, v1, above1);
   }
@@ -207,9 +208,6 @@ SR_HALF inline __m512 LoadHalf(__mmask16 m, const std::uint16_t* p) {
   return _mm512_cvtph_ps(_mm256_maskz_loadu_epi16(m, p));
 }
 SR_HALF inline float HalfToFloat(std::uint16_t h) { return _cvtsh_ss(h); }
-inline __mmask16 Lanes(int count) {  // the first min(count, 16) lanes, none if count ≤ 0
-  return static_cast<__mmask16>((1u << std::clamp(count, 0, 16)) - 1u);
-}
 
 // y[0, count) −= x · c[0, count), count ≤ 32 (the small triangles of the blocks).
 SR_HALF inline void AxpyHalfShort(int count, const std::uint16_t* c, float x, float* y) {
@@ -226,9 +224,6 @@ SR_HALF inline void AxpyHalfShort(int count, const std::uint16_t* c, float x, fl
 // chain from one column to the next stays in registers instead of passing through memory (x_k
 // stored, then loaded again: 58 % of a 195 × 195 solve from cache went there, bench_step
 // BM_BlockSolves). Each row's operations are AxpyHalfShort's, in its order: the same bits.
-SR_HALF inline __m512 LaneOf(__m512 v0, __m512 v1, int k) {
-  return _mm512_permutexvar_ps(_mm512_set1_epi32(k & 15), k < 16 ? v0 : v1);
-}
 // L (unit diagonal), from the left: x_i −= L_ik x_k for k < i < w.
 SR_HALF inline void LowerTriangleHalf(int w, const std::uint16_t* d, Eigen::Index ld, float* x) {
   const __mmask16 rows0 = Lanes(w), rows1 = Lanes(w - 16);
