@@ -450,7 +450,7 @@ void BM_CoarseLevelApply(benchmark::State& st) {
                      50.0 * MatX::Identity(3 * kNodes, 3 * kNodes));
   }
   std::vector<CoarseRod> rods;
-  for (int r = 0; r < helices; ++r) rods.push_back({.x = &x[static_cast<size_t>(r)], .eps = 1.02e-3, .node_offset = r * kNodes});
+  for (int r = 0; r < helices; ++r) rods.push_back({.x = &x[static_cast<size_t>(r)], .eps = 1.02e-3, .node_offset = r * kNodes, .fixed_nodes = 2});
   const CoarseLayout layout = st.range(1) == 0 ? CoarseLayout{}
                                                : CoarseLayout{.chunks_per_rod = 4, .turns = true, .points_per_chunk = 4};
   CoarseLevel coarse;

@@ -118,7 +118,8 @@ bool CapacitancePreconditioner::Build(const Model& model, double h,
   for (std::size_t r = 0; r < rods.size(); ++r)
     coarse_rods[r] = {.x = rods[r].x,
                       .eps = model.fluid.regularization * model.rods[r].radius,
-                      .node_offset = model.rods[r].node_offset};
+                      .node_offset = model.rods[r].node_offset,
+                      .fixed_nodes = model.rods[r].clamped_nodes};
   return coarse_level_.Build(coarse_rods, rod_blocks, h / (8.0 * kPi * model.fluid.viscosity));
 }
 

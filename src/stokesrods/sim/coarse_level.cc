@@ -122,7 +122,8 @@ void PutBlock(const Eigen::Matrix<double, K, K>& m, int a, int b, Eigen::MatrixX
 }  // namespace
 
 CoarseLayout CoarseLayout::For(int num_rods) {
-  if (num_rods <= kTurnsUpToRods) return {.chunks_per_rod = 4, .turns = true, .points_per_chunk = 4};
+  if (num_rods <= kTurnsUpToRods)
+    return {.chunks_per_rod = 4, .turns = true, .points_per_chunk = 4, .fixed_chunk = false};
   return {};
 }
 
@@ -146,11 +147,23 @@ bool CoarseLevel::Build(const std::vector<CoarseRod>& rods, const std::vector<Ma
   chunk_first_point_.clear();
   for (std::size_t r = 0; r < rods.size(); ++r) {
     const int n = static_cast<int>(rods[r].x->cols()), first = rods[r].node_offset;
-    const int chunks = std::min(layout.chunks_per_rod, n);
+    // The fixed nodes' chunk [first, first + fixed), then `free_chunks` over the rest.
+    const int fixed = layout.fixed_chunk && layout.chunks_per_rod >= 2 ? std::clamp(rods[r].fixed_nodes, 0, n - 1) : 0;
+    const int free_nodes = n - fixed;
+    const int free_chunks = std::min(layout.chunks_per_rod - (fixed > 0 ? 1 : 0), free_nodes);
+    const int chunks = free_chunks + (fixed > 0 ? 1 : 0);
     rod_first_chunk_.push_back(static_cast<int>(chunk_first_.size()));
     rod_first_node_.push_back(first);
+    // The free chunks' edges: evenly spaced, or graded from the fixed nodes.
+    const double grading = fixed > 0 ? CoarseLayout::kFreeChunkGrading : 1.0;
+    auto edge = [&](int k) {  // of free chunk k, k ≤ free_chunks, from the first free node
+      if (grading == 1.0 || k == free_chunks) return k * free_nodes / free_chunks;
+      return static_cast<int>(std::lround(free_nodes * std::pow(static_cast<double>(k) / free_chunks, grading)));
+    };
     for (int a = 0; a < chunks; ++a) {
-      const int begin = first + a * n / chunks, end = first + (a + 1) * n / chunks;
+      const int f = a - (fixed > 0 ? 1 : 0);  // the chunk among the free ones (−1: the fixed one)
+      const int begin = f < 0 ? first : first + fixed + edge(f);
+      const int end = f < 0 ? first + fixed : first + fixed + edge(f + 1);
       const int points = std::min(layout.points_per_chunk, end - begin);
       chunk_first_point_.push_back(static_cast<int>(point_first_.size()));
       for (int q = 0; q < points; ++q) {

@@ -1,5 +1,6 @@
 // The coarse level of the two-level preconditioner of the capacitance C = h 𝕄 + S X for the
-// matrix-free mobility (sim/hydro_coupling.h): per rod, K chunks of consecutive nodes, each with
+// matrix-free mobility (sim/hydro_coupling.h): per rod, K chunks of consecutive nodes (a clamp's
+// fixed nodes one of them where the layout says so: CoarseLayout::fixed_chunk), each with
 // a force F (3 modes) or a force and a turn Ω about the chunk's centroid X_b (6 modes: the nodal
 // forces F + Ω × (x_i − X_b) / ρ_b, ρ_b the chunk's RMS radius, so that a turn's columns are of
 // a force's size): the columns Z, 3K or 6K per rod; W ≈ C Z and E = Zᵀ W. One
@@ -42,6 +43,7 @@ struct CoarseRod {
   const Matrix3X* x = nullptr;  ///< node positions
   double eps = 0.0;             ///< regularization ε of its Stokeslets [m]
   int node_offset = 0;          ///< first global node
+  int fixed_nodes = 0;          ///< leading nodes held in place (the clamp)
 };
 
 /// How the coarse space is laid out per rod.
@@ -49,15 +51,33 @@ struct CoarseLayout {
   int chunks_per_rod = 8;    ///< chunks of consecutive nodes (fewer when a rod has fewer nodes)
   bool turns = false;        ///< each chunk's turn beside its force (6 modes, else 3)
   int points_per_chunk = 1;  ///< points carrying a chunk's modes in W between rods
+  /// A rod's fixed leading nodes (CoarseRod::fixed_nodes) as a chunk of their own, one of
+  /// chunks_per_rod, the others over its free nodes, graded from the fixed ones
+  /// (kFreeChunkGrading). C's rows there are h 𝕄 alone (no S X: they do not move),
+  /// and next to them S X is small (a cantilever's compliance grows as s³ from its clamp), so
+  /// one uniform force over fixed and nearly fixed nodes and the freer ones beyond fits neither;
+  /// between rods the forces near the clamps act together (a hundred clamps in a plane). GMRES
+  /// products per step (session 36, 40 steps after 60, eight chunks of forces): lattice50
+  /// 4.05 → 3.4 (→ 3.1 graded), lattice100 4.35 → 3.8 (→ 3.575 graded). With four chunks and
+  /// turns (the free nodes then in three chunks) lattice10 2.85 → 3.0, ring10 3.05 → 3.075,
+  /// lattice20 3.175 → 3.025: For sets it for the forces' layout only.
+  bool fixed_chunk = true;
   int modes() const { return turns ? 6 : 3; }
 
   /// Up to kTurnsUpToRods rods: four chunks of six modes, four points each (a chunk's turn needs
   /// more than its centroid: with W exact lattice20 takes 3.15 products per step, with two
-  /// points 3.75, with four 3.3); from there on eight chunks of forces at their centroids.
+  /// points 3.75, with four 3.3); from there on eight chunks of forces at their centroids, the
+  /// clamp's nodes one of them.
   /// Eight is the fastest of forces alone (one thread, GMRES products per step at 4 / 6 / 8 / 16
   /// chunks: lattice100 6.4 / 5.85 / 5.05 / 4.0, lattice50 6.0 / 5.0 / 5.0 / 4.0; 16: E's LU,
   /// (48 R)³ flops at every rebuild, and its solves cost more than they save).
   static constexpr int kTurnsUpToRods = 32;
+  /// With a fixed chunk, free chunk k of K ends at n_free (k / K)^g from the fixed nodes: finer
+  /// where S X is small beside h 𝕄 (sixty-three free nodes in seven chunks: 4, 7, 8, 10, 10,
+  /// 12, 12 nodes). GMRES products per step at g = 1, 1.2, 1.3, 1.4, 1.5, 1.6, 1.7, 2 (session
+  /// 36, one run each): lattice50 3.4, 3.15, 3.15, 3.1, –, 3.25, –, 3.475; lattice100 3.8, –,
+  /// 3.625, 3.575, 3.55, –, 3.75, 3.925.
+  static constexpr double kFreeChunkGrading = 1.4;
   static CoarseLayout For(int num_rods);
 };
 
