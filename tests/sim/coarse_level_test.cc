@@ -284,6 +284,40 @@ INSTANTIATE_TEST_SUITE_P(
              (param.param.fixed_chunk ? "FixedChunk" : "");
     });
 
+// Rods of a few nodes, two of them fixed: every chunk keeps at least one node (the graded edges
+// of the free chunks pushed apart), E stays regular and the solve finite.
+TEST(CoarseLevel, ShortClampedRodsKeepEveryChunk) {
+  std::vector<Matrix3X> x;
+  std::vector<MatX> blocks;
+  std::vector<CoarseRod> rods;
+  std::mt19937 rng(11);
+  std::normal_distribution<double> normal;
+  int offset = 0, expected_chunks = 0;
+  for (const int n : {3, 9, 10, 12, 20}) {
+    Matrix3X p(3, n);
+    for (int i = 0; i < n; ++i)
+      p.col(i) = Vec3(0.01 * std::cos(0.8 * i) + 0.04 * static_cast<double>(x.size()), 0.01 * std::sin(0.8 * i), 0.005 * i);
+    x.push_back(p);
+    blocks.push_back(MatX::NullaryExpr(3 * n, 3 * n, [&]() { return normal(rng); }) + 50.0 * MatX::Identity(3 * n, 3 * n));
+    expected_chunks += 1 + std::min(CoarseLayout{}.chunks_per_rod - 1, n - 2);
+    offset += n;
+  }
+  offset = 0;
+  for (std::size_t r = 0; r < x.size(); ++r) {
+    rods.push_back({.x = &x[r], .eps = kEps, .node_offset = offset, .fixed_nodes = 2});
+    offset += static_cast<int>(x[r].cols());
+  }
+  CoarseLevel coarse;
+  ASSERT_TRUE(coarse.Build(rods, blocks, kScale, CoarseLayout{}));
+  EXPECT_EQ(coarse.num_chunks(), expected_chunks);
+  const VecX v = VecX::NullaryExpr(3 * offset, [&]() { return normal(rng); });
+  const VecX c = coarse.Solve(v);
+  EXPECT_TRUE(c.allFinite());
+  VecX w;
+  coarse.ApplyW(c, &w);
+  EXPECT_TRUE(w.allFinite());
+}
+
 TEST(CoarseLevel, LayoutBySize) {  // turns for a few tens of rods, forces alone beyond
   EXPECT_TRUE(CoarseLayout::For(10).turns);
   EXPECT_TRUE(CoarseLayout::For(CoarseLayout::kTurnsUpToRods).turns);

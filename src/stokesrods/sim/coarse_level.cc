@@ -154,16 +154,21 @@ bool CoarseLevel::Build(const std::vector<CoarseRod>& rods, const std::vector<Ma
     const int chunks = free_chunks + (fixed > 0 ? 1 : 0);
     rod_first_chunk_.push_back(static_cast<int>(chunk_first_.size()));
     rod_first_node_.push_back(first);
-    // The free chunks' edges: evenly spaced, or graded from the fixed nodes.
-    const double grading = fixed > 0 ? CoarseLayout::kFreeChunkGrading : 1.0;
-    auto edge = [&](int k) {  // of free chunk k, k ≤ free_chunks, from the first free node
-      if (grading == 1.0 || k == free_chunks) return k * free_nodes / free_chunks;
-      return static_cast<int>(std::lround(free_nodes * std::pow(static_cast<double>(k) / free_chunks, grading)));
-    };
+    // The free chunks' edges from the first free node: evenly spaced, or graded from the fixed
+    // nodes (each chunk at least one node: a short rod's first edges pushed up).
+    std::vector<int> edge(static_cast<size_t>(free_chunks) + 1);
+    for (int k = 0; k <= free_chunks; ++k) {
+      int e = k * free_nodes / free_chunks;
+      if (fixed > 0 && k > 0 && k < free_chunks)
+        e = std::clamp(static_cast<int>(std::lround(free_nodes * std::pow(static_cast<double>(k) / free_chunks,
+                                                                         CoarseLayout::kFreeChunkGrading))),
+                       edge[static_cast<size_t>(k) - 1] + 1, free_nodes - (free_chunks - k));
+      edge[static_cast<size_t>(k)] = e;
+    }
     for (int a = 0; a < chunks; ++a) {
       const int f = a - (fixed > 0 ? 1 : 0);  // the chunk among the free ones (−1: the fixed one)
-      const int begin = f < 0 ? first : first + fixed + edge(f);
-      const int end = f < 0 ? first + fixed : first + fixed + edge(f + 1);
+      const int begin = f < 0 ? first : first + fixed + edge[static_cast<size_t>(f)];
+      const int end = f < 0 ? first + fixed : first + fixed + edge[static_cast<size_t>(f) + 1];
       const int points = std::min(layout.points_per_chunk, end - begin);
       chunk_first_point_.push_back(static_cast<int>(point_first_.size()));
       for (int q = 0; q < points; ++q) {
