@@ -89,7 +89,8 @@ struct Space {
   int modes() const { return layout.modes(); }
   // The chunks of rod r as CoarseLevel makes them: [first + a n / K, first + (a + 1) n / K), or
   // with a chunk of the f fixed nodes first, the other K − 1 over the n − f free ones, free chunk
-  // j from first + f + round((n − f) (j / (K − 1))^g), g = kFreeChunkGrading.
+  // j from first + f + round((n − f) (j / (K − 1))^g), g = kFreeChunkGrading (at 65 nodes no
+  // chunk is left empty, so no edge is pushed apart: ShortClampedRodsKeepEveryChunk).
   int ChunkBegin(int r, int a) const {
     const int f = layout.fixed_chunk ? fixed : 0;
     if (f == 0) return r * kNodes + a * kNodes / chunks();
@@ -208,50 +209,51 @@ MatX RegularizedE(const Space& z, MatX e) {
 // On the helices and on straight rods (a chunk on a line: a turn of zero force, E regular only by
 // its regularization).
 TEST_P(CoarseLevelLayout, SolveInvertsZTransposeW) {
-  for (const bool straight : {false, true})
-  for (const int fixed : {0, 2}) {
-    SCOPED_TRACE(fixed);
-    const Lattice l = MakeLattice(straight, fixed);
-    const Space z{GetParam(), fixed};
-    CoarseLevel coarse;
-    ASSERT_TRUE(coarse.Build(l.rods, l.blocks, kScale, z.layout)) << straight;
-    const MatX w = ReferenceW(l, z, false);
-    const MatX e = RegularizedE(z, ZTranspose(l, z, w));
-    std::mt19937 rng(5);
-    std::normal_distribution<double> normal;
-    const VecX v = VecX::NullaryExpr(w.rows(), [&]() { return normal(rng); });
-    const VecX c = coarse.Solve(v);
-    ASSERT_TRUE(c.allFinite()) << straight;
-    const VecX ztv = ZTranspose(l, z, v);
-    // E's LU factors are kept in half precision (DenseLu kHalf, where the CPU allows it, else in
-    // single): rounding them perturbs E by at most u |L||U| entrywise, u = 2⁻¹¹ (4.9e-4), which
-    // partial pivoting keeps near u ‖E‖ (the factorization's own single-precision error is 500×
-    // smaller). Residual within 2 u ‖E‖₂ ‖c‖ (measured 0.13 u ‖E‖₂ ‖c‖ with forces alone, which
-    // E's conditioning makes 1.1 % of ‖Zᵀv‖); an E inconsistent with W would miss by O(‖Zᵀv‖).
-    MatX u_svd, v_svd;
-    VecX sigma;
-    ASSERT_TRUE(ThinSvd(e, &u_svd, &sigma, &v_svd));
-    const double norm_e = sigma(0);
-    const double residual = (e * c - ztv).norm();
-    std::printf("  %s: coarse solve residual %.2e of ‖E‖‖c‖, %.2e of ‖Zᵀv‖, cond %.3g\n",
-                straight ? "straight rods" : "helices", residual / (norm_e * c.norm()),
-                residual / ztv.norm(), sigma(0) / sigma(sigma.size() - 1));
-    EXPECT_LT(residual, 2.0 * 4.9e-4 * norm_e * c.norm()) << straight;
-    // With a fixed chunk (two nodes) these synthetic blocks (random + 50 I, weaker than the two
-    // nodes' Stokeslets to the other rods) leave E near singular (condition 1.2e5 with forces
-    // alone on straight rods, 6.5e5 with turns, against 1e4 and 6.5e4 without): the backward
-    // test above (an inconsistent E misses it by its own relative error) is then the one that
-    // can hold.
-    if (fixed == 0) {
-      EXPECT_LT(residual, 0.05 * ztv.norm()) << straight;
+  for (const bool straight : {false, true}) {
+    for (const int fixed : {0, 2}) {
+      SCOPED_TRACE(fixed);
+      const Lattice l = MakeLattice(straight, fixed);
+      const Space z{GetParam(), fixed};
+      CoarseLevel coarse;
+      ASSERT_TRUE(coarse.Build(l.rods, l.blocks, kScale, z.layout)) << straight;
+      const MatX w = ReferenceW(l, z, false);
+      const MatX e = RegularizedE(z, ZTranspose(l, z, w));
+      std::mt19937 rng(5);
+      std::normal_distribution<double> normal;
+      const VecX v = VecX::NullaryExpr(w.rows(), [&]() { return normal(rng); });
+      const VecX c = coarse.Solve(v);
+      ASSERT_TRUE(c.allFinite()) << straight;
+      const VecX ztv = ZTranspose(l, z, v);
+      // E's LU factors are kept in half precision (DenseLu kHalf, where the CPU allows it, else in
+      // single): rounding them perturbs E by at most u |L||U| entrywise, u = 2⁻¹¹ (4.9e-4), which
+      // partial pivoting keeps near u ‖E‖ (the factorization's own single-precision error is 500×
+      // smaller). Residual within 2 u ‖E‖₂ ‖c‖ (measured 0.13 u ‖E‖₂ ‖c‖ with forces alone, which
+      // E's conditioning makes 1.1 % of ‖Zᵀv‖); an E inconsistent with W would miss by O(‖Zᵀv‖).
+      MatX u_svd, v_svd;
+      VecX sigma;
+      ASSERT_TRUE(ThinSvd(e, &u_svd, &sigma, &v_svd));
+      const double norm_e = sigma(0);
+      const double residual = (e * c - ztv).norm();
+      std::printf("  %s: coarse solve residual %.2e of ‖E‖‖c‖, %.2e of ‖Zᵀv‖, cond %.3g\n",
+                  straight ? "straight rods" : "helices", residual / (norm_e * c.norm()),
+                  residual / ztv.norm(), sigma(0) / sigma(sigma.size() - 1));
+      EXPECT_LT(residual, 2.0 * 4.9e-4 * norm_e * c.norm()) << straight;
+      // With a fixed chunk (two nodes) these synthetic blocks (random + 50 I, weaker than the two
+      // nodes' Stokeslets to the other rods) leave E near singular (condition 1.2e5 with forces
+      // alone on straight rods, 6.5e5 with turns, against 1e4 and 6.5e4 without): the backward
+      // test above (an inconsistent E misses it by its own relative error) is then the one that
+      // can hold.
+      if (fixed == 0) {
+        EXPECT_LT(residual, 0.05 * ztv.norm()) << straight;
+      }
+      VecX y = VecX::Zero(v.size());
+      coarse.AddZ(c, &y);  // Z c: each node takes its chunk's force (and turn), F + Ω × (x_i − X_b) / ρ_b
+      const int node = kNodes + 1, chunk = z.chunks();  // rod 1's second node, in its first chunk
+      const Vec3 d = (Node(l, node) - Centroid(l, z.ChunkBegin(1, 0), z.ChunkEnd(1, 0))) /
+                     Radius(l, z.ChunkBegin(1, 0), z.ChunkEnd(1, 0));
+      const VecX mine = c.segment(z.modes() * chunk, z.modes());
+      EXPECT_LT((y.segment<3>(3 * node) - z.Modes(d) * mine).norm(), 1e-12 * mine.norm()) << straight;
     }
-    VecX y = VecX::Zero(v.size());
-    coarse.AddZ(c, &y);  // Z c: each node takes its chunk's force (and turn), F + Ω × (x_i − X_b) / ρ_b
-    const int node = kNodes + 1, chunk = z.chunks();  // rod 1's second node, in its first chunk
-    const Vec3 d = (Node(l, node) - Centroid(l, z.ChunkBegin(1, 0), z.ChunkEnd(1, 0))) /
-                   Radius(l, z.ChunkBegin(1, 0), z.ChunkEnd(1, 0));
-    const VecX mine = c.segment(z.modes() * chunk, z.modes());
-    EXPECT_LT((y.segment<3>(3 * node) - z.Modes(d) * mine).norm(), 1e-12 * mine.norm()) << straight;
   }
 }
 
@@ -300,9 +302,7 @@ TEST(CoarseLevel, ShortClampedRodsKeepEveryChunk) {
     x.push_back(p);
     blocks.push_back(MatX::NullaryExpr(3 * n, 3 * n, [&]() { return normal(rng); }) + 50.0 * MatX::Identity(3 * n, 3 * n));
     expected_chunks += 1 + std::min(CoarseLayout{}.chunks_per_rod - 1, n - 2);
-    offset += n;
   }
-  offset = 0;
   for (std::size_t r = 0; r < x.size(); ++r) {
     rods.push_back({.x = &x[r], .eps = kEps, .node_offset = offset, .fixed_nodes = 2});
     offset += static_cast<int>(x[r].cols());

@@ -148,7 +148,8 @@ bool CoarseLevel::Build(const std::vector<CoarseRod>& rods, const std::vector<Ma
   for (std::size_t r = 0; r < rods.size(); ++r) {
     const int n = static_cast<int>(rods[r].x->cols()), first = rods[r].node_offset;
     // The fixed nodes' chunk [first, first + fixed), then `free_chunks` over the rest.
-    const int fixed = layout.fixed_chunk && layout.chunks_per_rod >= 2 ? std::clamp(rods[r].fixed_nodes, 0, n - 1) : 0;
+    const bool own_chunk = layout.fixed_chunk && layout.chunks_per_rod >= 2;
+    const int fixed = own_chunk ? std::clamp(rods[r].fixed_nodes, 0, n - 1) : 0;
     const int free_nodes = n - fixed;
     const int free_chunks = std::min(layout.chunks_per_rod - (fixed > 0 ? 1 : 0), free_nodes);
     const int chunks = free_chunks + (fixed > 0 ? 1 : 0);
@@ -159,10 +160,11 @@ bool CoarseLevel::Build(const std::vector<CoarseRod>& rods, const std::vector<Ma
     std::vector<int> edge(static_cast<size_t>(free_chunks) + 1);
     for (int k = 0; k <= free_chunks; ++k) {
       int e = k * free_nodes / free_chunks;
-      if (fixed > 0 && k > 0 && k < free_chunks)
-        e = std::clamp(static_cast<int>(std::lround(free_nodes * std::pow(static_cast<double>(k) / free_chunks,
-                                                                         CoarseLayout::kFreeChunkGrading))),
+      if (fixed > 0 && k > 0 && k < free_chunks) {
+        const double graded = std::pow(static_cast<double>(k) / free_chunks, CoarseLayout::kFreeChunkGrading);
+        e = std::clamp(static_cast<int>(std::lround(free_nodes * graded)),
                        edge[static_cast<size_t>(k) - 1] + 1, free_nodes - (free_chunks - k));
+      }
       edge[static_cast<size_t>(k)] = e;
     }
     for (int a = 0; a < chunks; ++a) {
