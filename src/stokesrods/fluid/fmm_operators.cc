@@ -54,6 +54,10 @@ std::unique_ptr<FmmOperators> MakeOperators(int order, double cutoff) {
     const Matrix3X parent_outer = (2.0 * outer).colwise() - 2.0 * o;  // in the child's units
     op->l2l[static_cast<size_t>(c)] = op->check_to_down * KernelMatrix(inner, parent_outer);
   }
+  for (std::size_t c = 0; c < 8; ++c) {
+    op->m2m_single[c] = op->m2m[c].cast<float>();
+    op->l2l_single[c] = op->l2l[c].cast<float>();
+  }
   return op;
 }
 

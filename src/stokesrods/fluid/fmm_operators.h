@@ -38,6 +38,10 @@ struct FmmOperators {
   std::array<MatX, 8> m2m;       ///< child c's upward densities → the parent's
   std::array<MatX, 8> l2l;       ///< parent's downward densities → child c's
   MatX check_to_down;            ///< downward check (r_in) → downward equivalent (r_out)
+  /// M2M and L2L rounded to single precision: the translations between levels of the sums in
+  /// single precision (tolerance ≥ 1e-4, p = 4; fmm_sum.cc). The fits check_to_up and
+  /// check_to_down stay in double there (see fmm_sum.cc).
+  std::array<Eigen::MatrixXf, 8> m2m_single, l2l_single;
 };
 
 inline constexpr double kFmmInnerRadius = 0.525;  ///< r_in in box widths

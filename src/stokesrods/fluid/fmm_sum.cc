@@ -54,10 +54,21 @@ namespace {
 
 constexpr double kEpsilonConstant = 2.0;  // c_ε
 
+extern "C" void sgemm_(const char* transa, const char* transb, const int* m, const int* n,
+                       const int* k, const float* alpha, const float* a, const int* lda,
+                       const float* b, const int* ldb, const float* beta, float* c, const int* ldc);
 extern "C" void dgemm_(const char* transa, const char* transb, const int* m, const int* n,
                        const int* k, const double* alpha, const double* a, const int* lda,
                        const double* b, const int* ldb, const double* beta, double* c,
                        const int* ldc);
+
+constexpr Eigen::Index kGemmColumns = 64;
+
+/// One operator of the dense translations, in double and rounded to single precision.
+struct Translation {
+  const MatX* a = nullptr;
+  const Eigen::MatrixXf* a_single = nullptr;
+};
 
 /// c_p = alpha a_p b_p for each p by the BLAS (OpenBLAS: its kernels for the CPU at hand, on one
 /// thread so that the result does not depend on the thread count (solver/blas.h); the build
@@ -67,9 +78,17 @@ extern "C" void dgemm_(const char* transa, const char* transb, const int* m, con
 /// thread, the fits and translations were the largest serial part of a two-thread step on a
 /// hundred helices: docs/performance.md, session 19; the M2M and L2L's eight products of a few
 /// blocks each, one after the other, left the second thread waiting: session 27.)
-constexpr Eigen::Index kGemmColumns = 64;
-void GemmByColumns(const std::vector<const MatX*>& a, const std::vector<const MatX*>& b,
-                   double alpha, std::vector<MatX*>* c) {
+/// With `single`, each block's columns are rounded to single precision and multiplied by a_p's
+/// single-precision copy (sgemm: twice the rate of dgemm, and half the operator to pack), the
+/// result returned in double. The sums in single precision (tolerance ≥ 1e-4, p = 4) take this
+/// for M2M and L2L: the FMM's error stays as it was (tests/fluid/stokeslet_sum_test.cc;
+/// bench_stokeslet_sum: 100 helices 4.2726e-5 → 4.2723e-5, 50: 5.7910e-5 → 5.7908e-5) and
+/// GMRES's products per step too (lattice50 3.025). Not for the fits check_to_up and check_to_down,
+/// pseudo-inverses cut at 1e-6 of their largest singular value, which amplify the rounding:
+/// their single precision took lattice50 from 3.025 to 4.0 (check_to_up) and 4.225
+/// (check_to_down) products per step (docs/performance.md, session 37).
+void GemmByColumns(const std::vector<Translation>& a, const std::vector<const MatX*>& b,
+                   double alpha, bool single, std::vector<MatX*>* c) {
   SR_ASSERT(BlasIsSingleThreaded(), "the BLAS must run on one thread");
   struct Block {
     std::size_t product;
@@ -77,39 +96,56 @@ void GemmByColumns(const std::vector<const MatX*>& a, const std::vector<const Ma
   };
   std::vector<Block> blocks;
   for (std::size_t p = 0; p < a.size(); ++p) {
-    SR_ASSERT(b[p]->rows() == a[p]->cols(), "GemmByColumns: sizes");
-    (*c)[p]->resize(a[p]->rows(), b[p]->cols());
-    if (a[p]->rows() == 0) continue;
+    SR_ASSERT(b[p]->rows() == a[p].a->cols(), "GemmByColumns: sizes");
+    SR_ASSERT(!single || (a[p].a_single != nullptr && a[p].a_single->rows() == a[p].a->rows()),
+              "GemmByColumns: no single-precision operator");
+    (*c)[p]->resize(a[p].a->rows(), b[p]->cols());
+    if (a[p].a->rows() == 0) continue;
     for (Eigen::Index first = 0; first < b[p]->cols(); first += kGemmColumns) blocks.push_back({p, first});
   }
   const int num_blocks = static_cast<int>(blocks.size());
-#pragma omp parallel for schedule(dynamic) if (num_blocks > 1)
-  for (int i = 0; i < num_blocks; ++i) {
-    const MatX& ap = *a[blocks[static_cast<size_t>(i)].product];
-    const MatX& bp = *b[blocks[static_cast<size_t>(i)].product];
-    MatX& cp = *(*c)[blocks[static_cast<size_t>(i)].product];
-    const Eigen::Index first = blocks[static_cast<size_t>(i)].first;
-    const int m = static_cast<int>(ap.rows()), k = static_cast<int>(ap.cols());
-    const int n = static_cast<int>(std::min(kGemmColumns, bp.cols() - first));
-    const char no = 'N';
-    const double zero = 0.0;
-    dgemm_(&no, &no, &m, &n, &k, &alpha, ap.data(), &m, bp.data() + first * k, &k, &zero,
-           cp.data() + first * m, &m);
+#pragma omp parallel if (num_blocks > 1)
+  {
+    Eigen::MatrixXf b_single, c_single;  // a block's columns, per thread
+#pragma omp for schedule(dynamic)
+    for (int i = 0; i < num_blocks; ++i) {
+      const Translation& ap = a[blocks[static_cast<size_t>(i)].product];
+      const MatX& bp = *b[blocks[static_cast<size_t>(i)].product];
+      MatX& cp = *(*c)[blocks[static_cast<size_t>(i)].product];
+      const Eigen::Index first = blocks[static_cast<size_t>(i)].first;
+      const int m = static_cast<int>(ap.a->rows()), k = static_cast<int>(ap.a->cols());
+      const int n = static_cast<int>(std::min(kGemmColumns, bp.cols() - first));
+      const char no = 'N';
+      if (single) {
+        b_single = bp.middleCols(first, n).cast<float>();
+        c_single.resize(m, n);
+        const float alpha_single = static_cast<float>(alpha), zero = 0.0f;
+        sgemm_(&no, &no, &m, &n, &k, &alpha_single, ap.a_single->data(), &m, b_single.data(), &k,
+               &zero, c_single.data(), &m);
+        cp.middleCols(first, n) = c_single.cast<double>();
+      } else {
+        const double zero = 0.0;
+        dgemm_(&no, &no, &m, &n, &k, &alpha, ap.a->data(), &m, bp.data() + first * k, &k, &zero,
+               cp.data() + first * m, &m);
+      }
+    }
   }
 }
 
 void GemmByColumns(const MatX& a, const MatX& b, double alpha, MatX* c) {
   std::vector<MatX*> out = {c};
-  GemmByColumns({&a}, {&b}, alpha, &out);
+  GemmByColumns({{&a, nullptr}}, {&b}, alpha, /*single=*/false, &out);
 }
 
 /// The translations between levels (M2M, L2L) of many boxes: out_j = ops[octant_j] in.col(column_j)
 /// for every entry j, as one BLAS product per octant (the boxes of one octant share the
 /// operator) instead of one matrix–vector product per box. Entry j's result is column slot[j] of
 /// (*products)[octant_j].
-void TranslateByOctant(const std::array<MatX, 8>& ops, const MatX& in,
-                       const std::vector<int>& column, const std::vector<int>& octant,
-                       std::array<MatX, 8>* products, std::vector<int>* slot) {
+void TranslateByOctant(const std::array<MatX, 8>& ops,
+                       const std::array<Eigen::MatrixXf, 8>& ops_single, bool single,
+                       const MatX& in, const std::vector<int>& column,
+                       const std::vector<int>& octant, std::array<MatX, 8>* products,
+                       std::vector<int>* slot) {
   std::array<int, 8> count{};
   slot->resize(column.size());
   for (std::size_t j = 0; j < column.size(); ++j)
@@ -120,10 +156,12 @@ void TranslateByOctant(const std::array<MatX, 8>& ops, const MatX& in,
     gathered[static_cast<size_t>(octant[j])].col((*slot)[j]) = in.col(column[j]);
   // The eight products' column blocks over the threads at once (one octant holds a few blocks at
   // most: alone, each product ran on one thread).
-  std::vector<const MatX*> a, b;
+  std::vector<Translation> a;
+  std::vector<const MatX*> b;
   std::vector<MatX*> c;
-  for (std::size_t o = 0; o < 8; ++o) a.push_back(&ops[o]), b.push_back(&gathered[o]), c.push_back(&(*products)[o]);
-  GemmByColumns(a, b, 1.0, &c);
+  for (std::size_t o = 0; o < 8; ++o)
+    a.push_back({&ops[o], &ops_single[o]}), b.push_back(&gathered[o]), c.push_back(&(*products)[o]);
+  GemmByColumns(a, b, 1.0, single, &c);
 }
 
 class FmmStokesletSum final : public StokesletSum {
@@ -342,7 +380,8 @@ void FmmStokesletSum::Upward() const {
         column.push_back(static_cast<int>(c));
         octant.push_back(static_cast<int>(children[c].code & 7));
       }
-    TranslateByOctant(op_->m2m, up_[static_cast<size_t>(l) + 1], column, octant, &moved, &slot);
+    TranslateByOctant(op_->m2m, op_->m2m_single, single_, up_[static_cast<size_t>(l) + 1], column,
+                      octant, &moved, &slot);
     MatX& parent_up = up_[static_cast<size_t>(l)];
 #pragma omp parallel for schedule(static)
     for (std::size_t b = 0; b < parents.size(); ++b) {
@@ -377,7 +416,8 @@ void FmmStokesletSum::Downward() const {
         column.push_back(boxes[b].parent);
         octant.push_back(static_cast<int>(boxes[b].code & 7));
       }
-    TranslateByOctant(op_->l2l, down_[static_cast<size_t>(l) - 1], column, octant, &moved, &slot);
+    TranslateByOctant(op_->l2l, op_->l2l_single, single_, down_[static_cast<size_t>(l) - 1], column,
+                      octant, &moved, &slot);
 #pragma omp parallel for schedule(static)
     for (std::size_t j = 0; j < box.size(); ++j)
       down.col(box[j]) += moved[static_cast<size_t>(octant[j])].col(slot[j]);  // one per box

@@ -50,8 +50,9 @@ std::vector<std::array<std::int64_t, 3>> FinestCells(const Matrix3X& p, const Ve
   std::vector<std::array<std::int64_t, 3>> out(static_cast<size_t>(p.cols()));
   for (Eigen::Index k = 0; k < p.cols(); ++k)
     for (int d = 0; d < 3; ++d)
-      out[static_cast<size_t>(k)][static_cast<size_t>(d)] = std::clamp<std::int64_t>(
-          static_cast<std::int64_t>((p(d, k) - corner[d]) / width * cells), 0, (1 << kMaxLevel) - 1);
+      out[static_cast<size_t>(k)][static_cast<size_t>(d)] =
+          std::clamp<std::int64_t>(static_cast<std::int64_t>((p(d, k) - corner[d]) / width * cells),
+                                   0, (1 << kMaxLevel) - 1);
   return out;
 }
 
@@ -65,7 +66,8 @@ std::vector<std::uint64_t> SortByCode(const Matrix3X& p, const Vec3& corner, dou
   std::vector<std::pair<std::uint64_t, int>> keyed(cells.size());
   for (std::size_t k = 0; k < cells.size(); ++k) keyed[k] = {Encode(cells[k]), static_cast<int>(k)};
   int bucket_level = 1;
-  while (bucket_level < kMaxLevel && (std::size_t{1} << (3 * bucket_level + 3)) <= keyed.size()) ++bucket_level;
+  while (bucket_level < kMaxLevel && (std::size_t{1} << (3 * bucket_level + 3)) <= keyed.size())
+    ++bucket_level;
   if (keyed.size() > 64) {
     const int shift = 3 * (kMaxLevel - bucket_level);
     std::vector<int> start((std::size_t{1} << (3 * bucket_level)) + 1, 0);
@@ -73,9 +75,11 @@ std::vector<std::uint64_t> SortByCode(const Matrix3X& p, const Vec3& corner, dou
     for (std::size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
     std::vector<std::pair<std::uint64_t, int>> bucketed(keyed.size());
     std::vector<int> next(start.begin(), start.end() - 1);
-    for (const auto& entry : keyed) bucketed[static_cast<size_t>(next[entry.first >> shift]++)] = entry;
+    for (const auto& entry : keyed)
+      bucketed[static_cast<size_t>(next[entry.first >> shift]++)] = entry;
     for (std::size_t b = 0; b + 1 < start.size(); ++b)
-      if (start[b + 1] - start[b] > 1) std::sort(bucketed.begin() + start[b], bucketed.begin() + start[b + 1]);
+      if (start[b + 1] - start[b] > 1)
+        std::sort(bucketed.begin() + start[b], bucketed.begin() + start[b + 1]);
     keyed.swap(bucketed);
   } else {
     std::sort(keyed.begin(), keyed.end());
