@@ -54,14 +54,6 @@ namespace {
 
 constexpr double kEpsilonConstant = 2.0;  // c_ε
 
-extern "C" void sgemm_(const char* transa, const char* transb, const int* m, const int* n,
-                       const int* k, const float* alpha, const float* a, const int* lda,
-                       const float* b, const int* ldb, const float* beta, float* c, const int* ldc);
-extern "C" void dgemm_(const char* transa, const char* transb, const int* m, const int* n,
-                       const int* k, const double* alpha, const double* a, const int* lda,
-                       const double* b, const int* ldb, const double* beta, double* c,
-                       const int* ldc);
-
 constexpr Eigen::Index kGemmColumns = 64;
 
 /// One operator of the dense translations, in double and rounded to single precision.
@@ -115,18 +107,15 @@ void GemmByColumns(const std::vector<Translation>& a, const std::vector<const Ma
       const Eigen::Index first = blocks[static_cast<size_t>(i)].first;
       const int m = static_cast<int>(ap.a->rows()), k = static_cast<int>(ap.a->cols());
       const int n = static_cast<int>(std::min(kGemmColumns, bp.cols() - first));
-      const char no = 'N';
       if (single) {
         b_single = bp.middleCols(first, n).cast<float>();
         c_single.resize(m, n);
-        const float alpha_single = static_cast<float>(alpha), zero = 0.0f;
-        sgemm_(&no, &no, &m, &n, &k, &alpha_single, ap.a_single->data(), &m, b_single.data(), &k,
-               &zero, c_single.data(), &m);
+        Gemm(m, n, k, static_cast<float>(alpha), ap.a_single->data(), m, b_single.data(), k, 0.0f,
+             c_single.data(), m);
         cp.middleCols(first, n) = c_single.cast<double>();
       } else {
-        const double zero = 0.0;
-        dgemm_(&no, &no, &m, &n, &k, &alpha, ap.a->data(), &m, bp.data() + first * k, &k, &zero,
-               cp.data() + first * m, &m);
+        Gemm(m, n, k, alpha, ap.a->data(), m, bp.data() + first * k, k, 0.0, cp.data() + first * m,
+             m);
       }
     }
   }

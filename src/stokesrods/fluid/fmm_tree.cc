@@ -60,9 +60,9 @@ std::vector<std::array<std::int64_t, 3>> FinestCells(const Matrix3X& p, const Ve
 /// codes. First by their box at the deepest level of at most about as many boxes as points (a
 /// stable counting sort), then each box's few points by their whole code: the order of one
 /// std::sort of (code, index) pairs, which took a quarter of the Build on a hundred helices.
-std::vector<std::uint64_t> SortByCode(const Matrix3X& p, const Vec3& corner, double width,
+/// `cells`: the points' FinestCells in the tree's root cube.
+std::vector<std::uint64_t> SortByCode(const std::vector<std::array<std::int64_t, 3>>& cells,
                                       std::vector<int>* order) {
-  const auto cells = FinestCells(p, corner, width);
   std::vector<std::pair<std::uint64_t, int>> keyed(cells.size());
   for (std::size_t k = 0; k < cells.size(); ++k) keyed[k] = {Encode(cells[k]), static_cast<int>(k)};
   int bucket_level = 1;
@@ -295,22 +295,27 @@ double Total(const FmmCost& cost, double far, double near, double points) {
 /// The least estimated cost over the depths ≥ 2 (as BuildFmmTree's loop counts it) of the tree
 /// whose root cube of side `width` starts at `corner`, from LevelGrid's counts, and its depth.
 /// Not `complete` when a level's grid was too large to count densely before the search ended
-/// (the cost of the levels counted, infinity if none).
+/// (the cost of the levels counted, infinity if none). With the points' cells in that cube, which
+/// the tree then sorts by.
 struct LeastCostDepth {
   double cost = std::numeric_limits<double>::infinity();
   int depth = 0;
   bool complete = true;
+  std::vector<std::array<std::int64_t, 3>> source_cells, target_cells;
 };
 LeastCostDepth LeastCost(const Matrix3X& sources, const Matrix3X& targets, const Vec3& corner,
                          double width, double min_leaf_width, const FmmCost& cost) {
-  const auto src = FinestCells(sources, corner, width), tgt = FinestCells(targets, corner, width);
+  LeastCostDepth best;
+  best.source_cells = FinestCells(sources, corner, width);
+  best.target_cells = FinestCells(targets, corner, width);
+  const auto& src = best.source_cells;
+  const auto& tgt = best.target_cells;
   std::array<std::int64_t, 3> largest{0, 0, 0};
   for (const auto* points : {&src, &tgt})
     for (const auto& c : *points)
       for (std::size_t d = 0; d < 3; ++d) largest[d] = std::max(largest[d], c[d]);
   const double points = static_cast<double>(sources.cols() + targets.cols());
   double far_cost = cost.per_point * points;
-  LeastCostDepth best;
   for (int level = 2; level <= kMaxLevel && width / static_cast<double>(1 << level) >= min_leaf_width;
        ++level) {
     const LevelGrid grid(src, tgt, largest, level);
@@ -368,15 +373,16 @@ FmmTree BuildFmmTree(const Matrix3X& sources, const Matrix3X& targets, double mi
   for (std::size_t i = 0; i < widths.size(); ++i)
     widened[i] = LeastCost(sources, targets, tree.corner, widths[i], min_leaf_width, cost);
   for (std::size_t i = 0; i < widths.size(); ++i)
-    if (widened[i].complete && widened[i].cost < least.cost) least = widened[i], tree.width = widths[i];
+    if (widened[i].complete && widened[i].cost < least.cost)
+      least = std::move(widened[i]), tree.width = widths[i];
   const int max_level = least.complete && least.depth >= 2 ? least.depth : kMaxLevel;
   std::vector<std::uint64_t> src, tgt;
 #pragma omp parallel sections
   {
 #pragma omp section
-    src = SortByCode(sources, tree.corner, tree.width, &tree.source_order);
+    src = SortByCode(least.source_cells, &tree.source_order);
 #pragma omp section
-    tgt = SortByCode(targets, tree.corner, tree.width, &tree.target_order);
+    tgt = SortByCode(least.target_cells, &tree.target_order);
   }
   const double points = static_cast<double>(sources.cols() + targets.cols());
   tree.levels.push_back(MakeLevel(0, src, tgt));

@@ -17,6 +17,13 @@ bool BlasIsSingleThreaded();
 /// features, unless OPENBLAS_CORETYPE is set.
 std::string BlasCoreName();
 
+/// c = alpha a b + beta c by the BLAS's gemm, column-major: a m × k (leading dimension lda), b
+/// k × n (ldb), c m × n (ldc). The one declaration of sgemm/dgemm in the project.
+void Gemm(int m, int n, int k, float alpha, const float* a, int lda, const float* b, int ldb,
+          float beta, float* c, int ldc);
+void Gemm(int m, int n, int k, double alpha, const double* a, int lda, const double* b, int ldb,
+          double beta, double* c, int ldc);
+
 /// y = A x (y resized), rows in blocks over the OpenMP threads (the BLAS itself runs on one).
 void Gemv(const Eigen::MatrixXf& a, const Eigen::VectorXf& x, Eigen::VectorXf* y);
 /// y = A x for a block of rows of a column-major matrix: rows [first, first + rows) of `a`.

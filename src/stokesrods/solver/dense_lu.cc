@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "stokesrods/common/assert.h"
+#include "stokesrods/solver/blas.h"
 #include "stokesrods/solver/lu_solve_avx512.h"
 
 extern "C" {
@@ -20,12 +21,6 @@ void strsm_(const char* side, const char* uplo, const char* transa, const char* 
 void dtrsm_(const char* side, const char* uplo, const char* transa, const char* diag, const int* m,
             const int* n, const double* alpha, const double* a, const int* lda, double* b,
             const int* ldb, std::size_t, std::size_t, std::size_t, std::size_t);
-void sgemm_(const char* transa, const char* transb, const int* m, const int* n, const int* k,
-            const float* alpha, const float* a, const int* lda, const float* b, const int* ldb,
-            const float* beta, float* c, const int* ldc, std::size_t, std::size_t);
-void dgemm_(const char* transa, const char* transb, const int* m, const int* n, const int* k,
-            const double* alpha, const double* a, const int* lda, const double* b, const int* ldb,
-            const double* beta, double* c, const int* ldc, std::size_t, std::size_t);
 void sgetrs_(const char* trans, const int* n, const int* nrhs, const float* a, const int* lda,
              const int* ipiv, float* b, const int* ldb, int* info, std::size_t trans_len);
 void dgetrs_(const char* trans, const int* n, const int* nrhs, const double* a, const int* lda,
@@ -58,11 +53,7 @@ void TrsmUnitLower(int m, int n, const Scalar* l, int ld, Scalar* b) {
 // c −= a b, a m × k, b k × n.
 template <typename Scalar>
 void GemmSubtract(int m, int n, int k, const Scalar* a, const Scalar* b, Scalar* c, int ld) {
-  const Scalar minus_one = -1, one = 1;
-  if constexpr (std::is_same_v<Scalar, float>)
-    sgemm_("N", "N", &m, &n, &k, &minus_one, a, &ld, b, &ld, &one, c, &ld, 1, 1);
-  else
-    dgemm_("N", "N", &m, &n, &k, &minus_one, a, &ld, b, &ld, &one, c, &ld, 1, 1);
+  Gemm(m, n, k, Scalar(-1), a, ld, b, ld, Scalar(1), c, ld);
 }
 
 // The LU with partial pivoting of a (n × n) by LAPACK's right-looking blocked algorithm (that of
