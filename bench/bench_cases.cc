@@ -81,9 +81,9 @@ std::vector<Vec3> RingBases(int n) {
 }
 
 std::vector<std::string> CaseNames() {
-  return {"fig1_h1ms", "fig1_h10ms", "fig1_explicit", "fig1_lsbt_N195", "ring10",
-          "lattice2",  "lattice4",   "lattice10",     "lattice20",      "lattice50",
-          "lattice100"};
+  return {"fig1_h1ms",  "fig1_h10ms", "fig1_explicit", "fig1_lsbt_N195", "ring10",
+          "lattice2",   "lattice4",   "lattice10",     "lattice20",      "lattice50",
+          "lattice100", "lattice200", "lattice400"};
 }
 
 std::optional<CaseSpec> FindCase(const std::string& name) {
@@ -96,7 +96,8 @@ std::optional<CaseSpec> FindCase(const std::string& name) {
     return CaseSpec{.name = name, .bases = fig1, .nodes = 195, .fluid = "lsbt"};
   if (name == "ring10") return CaseSpec{.name = name, .bases = RingBases(10)};
   const std::vector<std::pair<int, std::pair<int, int>>> lattices = {
-      {2, {1, 2}}, {4, {2, 2}}, {10, {2, 5}}, {20, {4, 5}}, {50, {5, 10}}, {100, {10, 10}}};
+      {2, {1, 2}},   {4, {2, 2}},     {10, {2, 5}},    {20, {4, 5}},
+      {50, {5, 10}}, {100, {10, 10}}, {200, {10, 20}}, {400, {20, 20}}};
   for (const auto& [count, shape] : lattices)
     if (name == fmt::format("lattice{}", count))
       return CaseSpec{.name = name, .bases = LatticeBases(shape.first, shape.second)};

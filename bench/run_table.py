@@ -22,9 +22,12 @@ import time
 
 ALL_CASES = ["fig1_h1ms", "fig1_h10ms", "fig1_explicit", "fig1_lsbt_N195", "ring10",
              "lattice2", "lattice4", "lattice10", "lattice20", "lattice50", "lattice100"]
+# Beyond the issue's hundred (from session 38): named with --cases or 'large', not in 'all' (a
+# round of both on one thread takes ~3 minutes, most of it lattice400's rebuilds).
+LARGE_CASES = ["lattice200", "lattice400"]
 ROD_COUNT = {"fig1_h1ms": 2, "fig1_h10ms": 2, "fig1_explicit": 2, "fig1_lsbt_N195": 2,
              "ring10": 10, "lattice2": 2, "lattice4": 4, "lattice10": 10, "lattice20": 20,
-             "lattice50": 50, "lattice100": 100}
+             "lattice50": 50, "lattice100": 100, "lattice200": 200, "lattice400": 400}
 # (warm-up, timed steps) per case when not given on the command line: fewer for the big ones.
 # The warm-up passes the start from rest: the clamps start turning at full speed at t = 0, and
 # for the first 20-60 steps (more with more rods) Newton needs 2 iterations (and GMRES up to 1.5x the products) where
@@ -35,15 +38,18 @@ ROD_COUNT = {"fig1_h1ms": 2, "fig1_h10ms": 2, "fig1_explicit": 2, "fig1_lsbt_N19
 # holds about one rebuild (lattice100: steps 41, 81, ...; ~400 ms on one thread), which the
 # median leaves out and the mean, and so the seconds per simulated second, now carries.
 DEFAULT_STEPS = {"lattice10": (60, 40), "lattice20": (60, 40), "lattice50": (60, 40),
-                 "lattice100": (60, 40)}
+                 "lattice100": (60, 40), "lattice200": (60, 40), "lattice400": (60, 40)}
 DEFAULT_WARMUP, DEFAULT_TIMED = 100, 50
 SCALING_CASES = ["lattice10", "lattice20", "lattice50", "lattice100"]
+# The growth at scale, when lattice200 or lattice400 ran: the fit from fifty on.
+LARGE_SCALING_CASES = ["lattice50", "lattice100", "lattice200", "lattice400"]
 
 
 def parse_args():
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--cases", default="all",
-                   help="comma-separated case names, or 'all' (default): " + ",".join(ALL_CASES))
+                   help="comma-separated case names, or 'all' (default): " + ",".join(ALL_CASES)
+                   + "; 'large' or by name: " + ",".join(LARGE_CASES))
     p.add_argument("--threads", default="1,2", help="comma-separated OMP_NUM_THREADS values")
     p.add_argument("--steps", type=int, help="timed steps of every case (default: 50, fewer "
                    "for lattice10 and up)")
@@ -74,10 +80,13 @@ def parse_args():
 def parse_cases_and_threads(p, cases, threads):
     """--cases (comma-separated, or 'all') and --threads (comma-separated integers ≥ 1) as
     lists; p.error on anything else."""
-    cases = ALL_CASES if cases == "all" else [c for c in cases.split(",") if c]
-    unknown = [c for c in cases if c not in ALL_CASES]
+    names = [c for c in cases.split(",") if c]
+    cases = []
+    for c in names:
+        cases += ALL_CASES if c == "all" else LARGE_CASES if c == "large" else [c]
+    unknown = [c for c in cases if c not in ALL_CASES + LARGE_CASES]
     if unknown:
-        p.error(f"unknown case(s) {', '.join(unknown)}; known: {', '.join(ALL_CASES)}")
+        p.error(f"unknown case(s) {', '.join(unknown)}; known: {', '.join(ALL_CASES + LARGE_CASES)}")
     try:
         threads = [int(t) for t in threads.split(",") if t]
     except ValueError:
@@ -325,6 +334,14 @@ def scaling(rows, threads_list, rounds=None):
                 msg += (f"; over all lattices that ran ({', '.join(lattice)}, small counts, "
                         f"not the asymptotic exponent): ms/step ≈ {pref:.3g} · rods^{slope:.2f}")
             out.append(msg)
+        if any(c in ran for c in LARGE_CASES):
+            pts = [(ROD_COUNT[c], ran[c]["ms_per_step_median"]) for c in LARGE_SCALING_CASES
+                   if c in ran]
+            if len(pts) >= 2:
+                slope, pref = fit_exponent(pts)
+                names = ", ".join(c for c in LARGE_SCALING_CASES if c in ran)
+                out.append(f"Scaling at scale, {t} thread(s), over {names}: ms/step ≈ {pref:.3g} · "
+                           f"rods^{slope:.2f}")
     return out
 
 
