@@ -23,7 +23,7 @@ import time
 ALL_CASES = ["fig1_h1ms", "fig1_h10ms", "fig1_explicit", "fig1_lsbt_N195", "ring10",
              "lattice2", "lattice4", "lattice10", "lattice20", "lattice50", "lattice100"]
 # Beyond the issue's hundred (from session 38): named with --cases or 'large', not in 'all' (a
-# round of both on one thread takes ~3 minutes, most of it lattice400's rebuilds).
+# round of both on one and two threads takes ~3 minutes, most of it lattice400's rebuilds).
 LARGE_CASES = ["lattice200", "lattice400"]
 ROD_COUNT = {"fig1_h1ms": 2, "fig1_h10ms": 2, "fig1_explicit": 2, "fig1_lsbt_N195": 2,
              "ring10": 10, "lattice2": 2, "lattice4": 4, "lattice10": 10, "lattice20": 20,
