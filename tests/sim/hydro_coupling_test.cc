@@ -54,16 +54,24 @@ struct TurnOutcome {
   int products_before = 0;  // the solve right after the preconditioner was built
   int products_after = 0;   // the turned system's, with the preconditioner kept
   double solution_error = 0.0;  // |δf₁ − Q δf₀| / |δf₀|
+  bool coarse_kept = false;     // after the turned system's factorization
 };
 
-TurnOutcome SolveBeforeAndAfterATurn(const std::string& mobility, bool rotate, double angle) {
+// `aged`: the preconditioner is past its age limit (40 steps) at the turn, so the turned system's
+// factorization rebuilds it, its coarse level kept or not as fluid.krylov_coarse_rebuild_period
+// = `coarse_period` says (0: by its cost, 1 for two helices).
+TurnOutcome SolveBeforeAndAfterATurn(const std::string& mobility, bool rotate, double angle,
+                                     bool aged = false, int coarse_period = 0) {
   const Model model = testing::ModelFromToml(testing::SmallHelicesToml(
       2, 17, 300,
       "model = \"rss\"\nmobility = \"" + mobility + "\"\nsolver = \"krylov\"\n" +
           std::string(mobility == "matrix_free"
-                          ? "far_field_tolerance = 1e-10\nfast_sum_tolerance = 1e-10\n" : "") +
-      "krylov_tolerance = 1e-10\nmobility_reuse_tolerance = 0\nkrylov_rotate_preconditioner = " +
-          std::string(rotate ? "true" : "false"),
+                          ? "far_field_tolerance = 1e-10\nfast_sum_tolerance = 1e-10\n"
+                          : "") +
+          "krylov_tolerance = 1e-10\nmobility_reuse_tolerance = 0\nkrylov_rotate_preconditioner "
+          "= " +
+          std::string(rotate ? "true" : "false") +
+          "\nkrylov_coarse_rebuild_period = " + std::to_string(coarse_period),
       "time_step = 0.01"));
   const double h = 0.01;
   State start = MakeRestState(model);
@@ -98,10 +106,14 @@ TurnOutcome SolveBeforeAndAfterATurn(const std::string& mobility, bool rotate, d
   VecX df0, df1;
   const long builds = ws.hydro.preconditioner_builds();
   out.products_before = solve(start, r_q, r_u, &df0);
+  if (aged)
+    for (int k = 0; k < 40; ++k) PrepareStep(model, start, &ws);
   const Mat3 turn = Eigen::AngleAxisd(angle, Vec3(0.3, -0.2, 1.0).normalized()).toRotationMatrix();
   out.products_after = solve(Turned(model, turn, start), TurnedDofs(model, turn, r_q),
                              TurnedNodes(turn, r_u), &df1);
-  EXPECT_EQ(ws.hydro.preconditioner_builds(), builds + 1) << "the preconditioner was rebuilt";
+  EXPECT_EQ(ws.hydro.preconditioner_builds(), builds + (aged ? 2 : 1))
+      << "the preconditioner was rebuilt, or not, unexpectedly";
+  out.coarse_kept = ws.hydro.coarse_kept();
   out.solution_error = (df1 - TurnedNodes(turn, df0)).norm() / df0.norm();
   return out;
 }
@@ -125,6 +137,37 @@ TEST(HydroCoupling, KeptPreconditionerFollowsARigidTurn) {
     EXPECT_LT(rotated.solution_error, 1e-8);
     EXPECT_LT(as_built.solution_error, 1e-8);
   }
+}
+
+// The coarse level kept across a rebuild of the blocks (period 2) and applied in its own frame,
+// turned by each rod's rotation since its build: after a rigid turn of the whole configuration
+// it is the coarse level a build there gives, turned (Q E⁻¹ Qᵀ), so the turned system takes the
+// same GMRES products as with the coarse level rebuilt (period 1) and the same solution. Applied
+// unturned it takes 10 and 17 products instead of 7 (checked by removing its rotation).
+TEST(HydroCoupling, KeptCoarseLevelFollowsARigidTurn) {
+  for (double angle : {0.1, 0.5}) {
+    const TurnOutcome kept = SolveBeforeAndAfterATurn("matrix_free", true, angle, true, 2);
+    const TurnOutcome rebuilt = SolveBeforeAndAfterATurn("matrix_free", true, angle, true, 1);
+    std::printf(
+        "turn of %.1f rad, then a rebuild: GMRES products %d (coarse level kept), %d "
+        "(rebuilt); solution against the turned one %.2e, %.2e\n",
+        angle, kept.products_after, rebuilt.products_after, kept.solution_error,
+        rebuilt.solution_error);
+    EXPECT_TRUE(kept.coarse_kept);
+    EXPECT_FALSE(rebuilt.coarse_kept);
+    EXPECT_EQ(kept.products_after, rebuilt.products_after);
+    EXPECT_LT(kept.solution_error, 1e-8);
+    EXPECT_LT(rebuilt.solution_error, 1e-8);
+  }
+}
+
+TEST(HydroCoupling, CoarseRebuildPeriodGrowsWithTheCoarseLevelsCost) {
+  // E of 24 unknowns per rod of 65 nodes: every rebuild up to a hundred helices, then as √(R²).
+  EXPECT_EQ(CoarseRebuildPeriod(24 * 10, 650), 1);
+  EXPECT_EQ(CoarseRebuildPeriod(24 * 100, 6500), 1);
+  EXPECT_EQ(CoarseRebuildPeriod(24 * 200, 13000), 2);
+  EXPECT_EQ(CoarseRebuildPeriod(24 * 400, 26000), 4);
+  EXPECT_EQ(CoarseRebuildPeriod(0, 6500), 1);  // no coarse level
 }
 
 }  // namespace

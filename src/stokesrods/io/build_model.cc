@@ -201,6 +201,7 @@ Model BuildModel(const Config& config) {
       config.fluid.solver == "direct" ? HydroSolver::kDirect : HydroSolver::kKrylov;
   model.hydro.krylov_tolerance = config.fluid.krylov_tolerance;
   model.hydro.rotate_preconditioner = config.fluid.krylov_rotate_preconditioner;
+  model.hydro.coarse_rebuild_period = config.fluid.krylov_coarse_rebuild_period;
   model.hydro.mobility.tolerance = config.fluid.far_field_tolerance;
   model.hydro.mobility.fast_sum_tolerance = config.fluid.fast_sum_tolerance;
   // Cell bodies: the far-field sum in single precision (from 1e-4) is not linear to round-off, and

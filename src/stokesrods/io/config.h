@@ -59,6 +59,8 @@ struct FluidConfig {
   std::string solver = "krylov";      ///< implicit coupling: "krylov" (GMRES) | "direct" (dense LU)
   double krylov_tolerance = 1e-6;     ///< GMRES relative residual [–]
   bool krylov_rotate_preconditioner = true;  ///< the kept preconditioner follows the rods' rotation
+  int krylov_coarse_rebuild_period =
+      0;  ///< matrix-free: coarse level rebuilt every k rebuilds; 0: by cost
 };
 
 struct ContactConfig {

@@ -35,6 +35,7 @@ void VisitFields(FluidConfig& c, V& v) {
   v("solver", c.solver);
   v("krylov_tolerance", c.krylov_tolerance);
   v("krylov_rotate_preconditioner", c.krylov_rotate_preconditioner);
+  v("krylov_coarse_rebuild_period", c.krylov_coarse_rebuild_period);
 }
 template <class V>
 void VisitFields(ContactConfig& c, V& v) {

@@ -131,6 +131,8 @@ void ValidateConfig(Config* config) {
                       "\"direct\" needs the dense mobility (fluid.mobility = \"dense\")");
   c.Positive("fluid.far_field_tolerance", config->fluid.far_field_tolerance);
   c.Positive("fluid.krylov_tolerance", config->fluid.krylov_tolerance);
+  c.Range("fluid.krylov_coarse_rebuild_period", config->fluid.krylov_coarse_rebuild_period, 0,
+          1000000);
   if (config->fluid.far_field_tolerance >= 1e-2)
     throw ConfigError(c.file, "fluid.far_field_tolerance", "must be below 1e-2");
   c.Positive("fluid.fast_sum_tolerance", config->fluid.fast_sum_tolerance);

@@ -92,7 +92,8 @@ bool CapacitancePreconditioner::Build(const Model& model, double h,
                                       const std::vector<MatX>& rod_blocks,
                                       const std::vector<HydroRod>& rods,
                                       const std::vector<BodySurface>& bodies,
-                                      const std::vector<ClampBorder>* borders, bool coarse) {
+                                      const std::vector<ClampBorder>* borders, bool coarse,
+                                      bool keep_coarse) {
   SR_ASSERT(rod_blocks.size() == model.rods.size() && rods.size() == model.rods.size() &&
                 bodies.size() == model.bodies.size(),
             "preconditioner: one block per rod and per body");
@@ -112,8 +113,14 @@ bool CapacitancePreconditioner::Build(const Model& model, double h,
   for (int k = 0; k < static_cast<int>(bodies.size()); ++k)
     if (bodies[static_cast<size_t>(k)].free && !BuildFreeBody(model, h, k, bodies, borders))
       return false;
+  const bool had_coarse = coarse_ && coarse_level_.num_chunks() > 0;
   coarse_ = coarse && !rods.empty();
   if (!coarse_) return true;
+  if (keep_coarse && had_coarse) {
+    coarse_kept_ = true;
+    return true;
+  }
+  coarse_kept_ = false;
   std::vector<CoarseRod> coarse_rods(model.rods.size());
   for (std::size_t r = 0; r < rods.size(); ++r)
     coarse_rods[r] = {.x = rods[r].x,
@@ -222,6 +229,37 @@ void CapacitancePreconditioner::SolveFine(const VecX& v, VecX* out) const {
     for (std::size_t p = 0; p < fb.rows.size(); ++p)
       blocks_[static_cast<size_t>(fb.blocks[p])].Scatter(-fb.columns_solved[p] * motion, out);
   }
+}
+
+void CapacitancePreconditioner::Apply(const VecX& v, VecX* out, const RodRotations& fine,
+                                      const RodRotations& coarse) const {
+  SR_ASSERT(v.size() == size_, "preconditioner: vector of the wrong size");
+  if (!coarse_ || !coarse_kept_) {  // one build: Q P₀ Qᵀ v
+    if (fine.empty()) return Apply(v, out);
+    turned_ = v;
+    fine.Apply(true, &turned_);
+    Apply(turned_, out);
+    fine.Apply(false, out);
+    return;
+  }
+  // The coarse level of an earlier build, at other positions: each level in its own frame,
+  //   c = E⁻¹ Zᵀ Q_cᵀ v,   y = Q_c Z c + Q_f Fine⁻¹ Q_fᵀ (v − Q_c W c).
+  turned_ = v;
+  if (!coarse.empty()) coarse.Apply(true, &turned_);
+  const VecX c = coarse_level_.Solve(turned_);
+  coarse_level_.ApplyW(c, &coarse_w_);
+  coarse_z_.setZero(v.size());
+  coarse_level_.AddZ(c, &coarse_z_);
+  if (!coarse.empty()) {  // both on the rods' nodes only (W and Z are zero elsewhere)
+    coarse.Apply(false, &coarse_w_);
+    coarse.Apply(false, &coarse_z_);
+  }
+  turned_ = v;
+  turned_.head(coarse_w_.size()) -= coarse_w_;
+  if (!fine.empty()) fine.Apply(true, &turned_);
+  SolveFine(turned_, out);
+  if (!fine.empty()) fine.Apply(false, out);
+  *out += coarse_z_;
 }
 
 void CapacitancePreconditioner::Apply(const VecX& v, VecX* out) const {

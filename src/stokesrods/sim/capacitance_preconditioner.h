@@ -38,18 +38,41 @@
 
 namespace stokesrods {
 
+/// Per rod, a rotation R_k of its nodes' entries (3 per node from 3 first_node[k]); the other
+/// entries (the bodies' points, the free bodies' motions) are left as they are.
+struct RodRotations {
+  std::vector<Mat3> rotation;   ///< per rod; empty: none
+  std::vector<int> first_node;  ///< per rod
+  std::vector<int> nodes;       ///< per rod
+  bool empty() const { return rotation.empty(); }
+  /// x ← Q x, or Qᵀ x when `transpose`.
+  void Apply(bool transpose, VecX* x) const;
+};
+
 class CapacitancePreconditioner {
  public:
   /// `rod_blocks`: D_k of each rod (3N_k square); `rods`: the rods as the fluid sees them (for
   /// the cell blocks and the coarse level); `bodies`: the surfaces at the step's start (the
   /// model's order); `borders`: the rods on free bodies (Γ, K and row_x completed) or nullptr;
   /// `coarse`: with the coarse level. C = h𝕄 + …: h scales the bodies' blocks and borders (1 for
-  /// 𝕄 itself). False if a block or a Schur complement is singular.
+  /// 𝕄 itself). `keep_coarse`: the coarse level of the previous Build stays as it was built (the
+  /// caller applies it in its own frame: the four-argument Apply). False if a block or a Schur
+  /// complement is singular.
   bool Build(const Model& model, double h, const std::vector<MatX>& rod_blocks,
              const std::vector<HydroRod>& rods, const std::vector<BodySurface>& bodies,
-             const std::vector<ClampBorder>* borders, bool coarse);
-  /// out ≈ C⁻¹ v.
+             const std::vector<ClampBorder>* borders, bool coarse, bool keep_coarse = false);
+  /// out ≈ C⁻¹ v at the positions of the build.
   void Apply(const VecX& v, VecX* out) const;
+  /// out ≈ C⁻¹ v with the rods turned since the build: Q P₀ Qᵀ v, Q = `fine` (empty: none). A
+  /// coarse level kept from an earlier build (Build's keep_coarse) is applied in its own frame,
+  /// Q = `coarse`, the rods' rotations since that build.
+  void Apply(const VecX& v, VecX* out, const RodRotations& fine, const RodRotations& coarse) const;
+  /// Whether the coarse level is one kept from an earlier build.
+  bool coarse_kept() const { return coarse_kept_; }
+  /// E's size: the coarse level's unknowns (0 without one).
+  int coarse_unknowns() const {
+    return coarse_ ? coarse_level_.num_chunks() * coarse_level_.layout().modes() : 0;
+  }
 
  private:
   /// A diagonal block of the fine level: the unknowns of one rod, one body, or a cell (a body
@@ -90,7 +113,9 @@ class CapacitancePreconditioner {
   std::vector<FreeBody> free_bodies_;
   int size_ = 0;
   bool coarse_ = false;
+  bool coarse_kept_ = false;  ///< the coarse level is from an earlier Build
   CoarseLevel coarse_level_;
+  mutable VecX turned_, coarse_w_, coarse_z_;  ///< the four-argument Apply's vectors
 };
 
 }  // namespace stokesrods

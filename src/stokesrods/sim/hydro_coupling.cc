@@ -104,6 +104,19 @@ constexpr int kPreconditionerMaxAge = 40;
 constexpr int kRebuildCostInProducts = 24;
 constexpr int kBlockRebuildCostInProducts = 8;
 
+// n_c³ / M of a hundred helices (n_c = 2400 coarse unknowns, M = 6500 nodes): the scale at which
+// one coarse build per rebuild pays (docs/performance.md, session 39: at two hundred helices
+// a period of 2 and at four hundred of 3–4 took the mean step down, at a hundred 2 was within
+// the noise).
+constexpr double kCoarseKeepScale = 2.1e6;
+
+int CoarseRebuildPeriod(int coarse_unknowns, int nodes) {
+  if (coarse_unknowns <= 0 || nodes <= 0) return 1;
+  const double n = coarse_unknowns;
+  const double ratio = n * n * n / (kCoarseKeepScale * nodes);
+  return std::max(1, static_cast<int>(std::lround(std::sqrt(ratio))));
+}
+
 void HydroCoupling::Init(const Model& model) {
   mobility_ = MakeModelMobility(model);
   krylov_ = model.hydro.solver == HydroSolver::kKrylov;
@@ -180,6 +193,10 @@ void HydroCoupling::ForgetReuse(const VecX& drag_guess) {
   wants_refresh_ = false;
   excess_products_ = 0;
   preconditioner_rotations_ = RodRotations{};
+  coarse_rotations_ = RodRotations{};
+  coarse_positions_.clear();
+  builds_since_coarse_ = 0;
+  slowed_severely_ = false;
   mobility_changed_ = true;
   explicit_blocks_.reset();
   explicit_blocks_age_ = 0;
@@ -234,9 +251,27 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
       std::vector<MatX> blocks(model.rods.size());
       for (std::size_t r = 0; r < model.rods.size(); ++r)
         blocks[r] = h * mobility_->SelfBlock(static_cast<int>(r)) + sx_blocks_[r];
+      // The coarse level is kept from an earlier build (in its own frame) for coarse_period_
+      // builds, unless h changed or GMRES took more than twice its products after a rebuild.
+      const bool keep_coarse = rotate_preconditioner_ && !coarse_positions_.empty() &&
+                               coarse_h_ == h && !slowed_severely_ &&
+                               builds_since_coarse_ + 1 < coarse_period_;
       if (!capacitance_blocks_.Build(model, h, blocks, MakeHydroRods(model, positions_), bodies_,
-                                     borders_, true))
+                                     borders_, true, keep_coarse))
         return have_preconditioner_ = false;
+      if (keep_coarse) {
+        ++builds_since_coarse_;
+        RotationsSince(model, coarse_positions_, &coarse_rotations_);
+      } else {
+        builds_since_coarse_ = 0;
+        coarse_h_ = h;
+        coarse_positions_ = preconditioner_positions_;
+        coarse_rotations_ = RodRotations{};
+        coarse_period_ =
+            model.hydro.coarse_rebuild_period > 0
+                ? model.hydro.coarse_rebuild_period
+                : CoarseRebuildPeriod(capacitance_blocks_.coarse_unknowns(), model.num_nodes);
+      }
     } else if (krylov_ && !borders_ && mobility_->single_matrix() != nullptr) {
       // The reused 𝕄 is single precision already: C for the float LU in one pass.
       Eigen::MatrixXf capacitance = static_cast<float>(h) * *mobility_->single_matrix();
@@ -256,6 +291,7 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
   }
   mobility_changed_ = false;
   wants_refresh_ = false;
+  slowed_severely_ = false;
   return true;
 }
 
@@ -326,24 +362,35 @@ void HydroCoupling::UpdatePreconditionerRotations(const Model& model) {
   if (!rotate_preconditioner_ || !have_preconditioner_ ||
       preconditioner_positions_.size() != positions_.size())
     return;
-  RodRotations& q = preconditioner_rotations_;
-  q.rotation.resize(positions_.size());
+  RotationsSince(model, preconditioner_positions_, &preconditioner_rotations_);
+  if (capacitance_blocks_.coarse_kept() && coarse_positions_.size() == positions_.size())
+    RotationsSince(model, coarse_positions_, &coarse_rotations_);
+  else
+    coarse_rotations_ = RodRotations{};
+}
+
+void HydroCoupling::RotationsSince(const Model& model, const std::vector<Matrix3X>& built,
+                                   RodRotations* q) const {
   const int num_rods = static_cast<int>(positions_.size());
+  q->rotation.resize(positions_.size());
+  q->first_node.resize(positions_.size());
+  q->nodes.resize(positions_.size());
   ForEachStatic(num_rods, RodsInParallel(num_rods, model.num_nodes), [&](int ri) {
     const auto r = static_cast<std::size_t>(ri);
-    q.rotation[r] = Mat3::Identity();
+    q->first_node[r] = model.rods[r].node_offset;
+    q->nodes[r] = model.rods[r].num_nodes();
+    q->rotation[r] = Mat3::Identity();
     // A rod clamped on a body turns with it; its cell's block holds the body's points, which
     // stay as built: the rod's block is applied as built too.
     if (model.rods[r].body >= 0) return;
     // Kabsch: the rotation R maximizing Σ (x_i − x̄)ᵀ R (x⁰_i − x̄⁰) is U diag(1, 1, ±1) Vᵀ
     // from the SVD U Σ Vᵀ of Σ (x_i − x̄)(x⁰_i − x̄⁰)ᵀ, the sign making det R = +1.
     const Matrix3X& now = positions_[r];
-    const Mat3 covariance =
-        (now.colwise() - now.rowwise().mean()) * preconditioner_positions_[r].transpose();
+    const Mat3 covariance = (now.colwise() - now.rowwise().mean()) * built[r].transpose();
     const Eigen::JacobiSVD<Mat3> svd(covariance, Eigen::ComputeFullU | Eigen::ComputeFullV);
     Mat3 sign = Mat3::Identity();
     if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0) sign(2, 2) = -1.0;
-    q.rotation[r] = svd.matrixU() * sign * svd.matrixV().transpose();
+    q->rotation[r] = svd.matrixU() * sign * svd.matrixV().transpose();
   });
 }
 
@@ -358,6 +405,8 @@ void RodRotations::Apply(bool transpose, VecX* x) const {
 }
 
 void HydroCoupling::Precondition(const VecX& v, VecX* out) const {
+  if (block_preconditioner_)  // Q P₀ Qᵀ v, each level in its own frame
+    return capacitance_blocks_.Apply(v, out, preconditioner_rotations_, coarse_rotations_);
   const RodRotations& q = preconditioner_rotations_;
   const VecX* in = &v;
   if (!q.empty()) {  // Q P₀ Qᵀ v
@@ -365,13 +414,9 @@ void HydroCoupling::Precondition(const VecX& v, VecX* out) const {
     q.Apply(true, &scratch_);
     in = &scratch_;
   }
-  if (block_preconditioner_) {
-    capacitance_blocks_.Apply(*in, out);
-  } else {
-    Eigen::VectorXf x = in->cast<float>();
-    capacitance_lu_float_.Solve(&x);
-    *out = x.cast<double>();
-  }
+  Eigen::VectorXf x = in->cast<float>();
+  capacitance_lu_float_.Solve(&x);
+  *out = x.cast<double>();
   if (!q.empty()) q.Apply(false, out);
 }
 
@@ -424,9 +469,10 @@ HydroSolveReport HydroCoupling::SolveNewtonSystem(const Model& model,
       worst_solve_ = report;
     if (iterations_after_refresh_ < 0) iterations_after_refresh_ = g.iterations;
     excess_products_ += std::max(0, g.iterations - iterations_after_refresh_);
-    wants_refresh_ = g.iterations > 2 * iterations_after_refresh_ + 2 ||
-                     excess_products_ >= (block_preconditioner_ ? kBlockRebuildCostInProducts
-                                                                : kRebuildCostInProducts);
+    slowed_severely_ = g.iterations > 2 * iterations_after_refresh_ + 2;
+    wants_refresh_ =
+        slowed_severely_ || excess_products_ >= (block_preconditioner_ ? kBlockRebuildCostInProducts
+                                                                       : kRebuildCostInProducts);
   }
   // δq = y + X δf = y + B⁻¹ Sᵀ δf;  du = S δq/h + 𝕄 δf = (S y + C δf)/h.
   if (x_df.size() == 0) SolveBanded(model, *df, nullptr, &x_df);  // direct, or δf = 0

@@ -1,8 +1,8 @@
 // Nonlocal hydrodynamics (RSS, LSBT) inside the implicit Euler step (paper eqs. 16, 21, 22).
 //
 // The mobility 𝕄 (U = 𝕄 F, fluid/mobility_operator.h) is taken at q(t_k) and kept for the step.
-//   explicit (paper Algorithm 1): the drag f = −𝕄⁻¹ U(t_k), a constant force during the Newton solve;
-//   implicit (default):           the drag f on the rods is an unknown beside q, with
+//   explicit (paper Algorithm 1): the drag f = −𝕄⁻¹ U(t_k), a constant force during the Newton
+//   solve; implicit (default):           the drag f on the rods is an unknown beside q, with
 //                                 r_q = M(q − q_k − h v_k)/h² − F(q) − Sᵀ f = 0   (momentum)
 //                                 r_u = S(q − q_k)/h + 𝕄 f = 0                   (no slip)
 //                                 S the selection of the free position DOFs.
@@ -30,6 +30,10 @@
 // Measured (docs/performance.md, session 19): Fig. 1 over 75 s at h = 40 ms 27 196 → 14 798
 // products; ten helices at h = 10 ms 23.3 → 11.9 per step; unchanged at h = 1 ms from ten
 // helices up.
+// The matrix-free path's coarse level (E's LU, O(R³) for R rods) may outlive the blocks: it is
+// rebuilt at every CoarseRebuildPeriod-th rebuild only, between them applied in its own frame with
+// the rods' rotations since its build (CapacitancePreconditioner::Apply), unless h changed or GMRES
+// slowed severely. The period is 1 (every rebuild) up to about 150 helices.
 // Since r_u is linear in (q, f), after a full Newton step it is the GMRES residual / h; along a
 // damped step it changes linearly, so line-search trials need no product with 𝕄.
 #pragma once
@@ -49,17 +53,6 @@
 #include "stokesrods/solver/dense_lu.h"
 
 namespace stokesrods {
-
-/// Per rod, a rotation R_k of its nodes' entries (3 per node from 3 first_node[k]); the other
-/// entries (the bodies' points, the free bodies' motions) are left as they are.
-struct RodRotations {
-  std::vector<Mat3> rotation;   ///< per rod; empty: none
-  std::vector<int> first_node;  ///< per rod
-  std::vector<int> nodes;       ///< per rod
-  bool empty() const { return rotation.empty(); }
-  /// x ← Q x, or Qᵀ x when `transpose`.
-  void Apply(bool transpose, VecX* x) const;
-};
 
 struct HydroSolveReport {
   bool ok = true;
@@ -131,6 +124,8 @@ class HydroCoupling {
   void ResetSolveReport() { worst_solve_ = HydroSolveReport{}; }
   long krylov_iterations() const { return krylov_total_; }  ///< over the whole run
   long preconditioner_builds() const { return preconditioner_builds_; }  ///< over the whole run
+  /// Whether the preconditioner's coarse level is one kept from an earlier build.
+  bool coarse_kept() const { return capacitance_blocks_.coarse_kept(); }
 
  private:
   void ApplyCapacitance(const Model& model, double h, const VecX& v, VecX* out) const;
@@ -142,8 +137,12 @@ class HydroCoupling {
   void Precondition(const VecX& v, VecX* out) const;
   // At a rebuild: the rods' nodes about their centroids, and the rotations' layout.
   void StartPreconditionerRotations(const Model& model);
-  // R_k of each rod since the preconditioner was built (see above), at every Prepare.
+  // R_k of each rod since the preconditioner was built (see above), at every Prepare; and since
+  // its coarse level was, where that one is kept from an earlier build.
   void UpdatePreconditionerRotations(const Model& model);
+  // R_k of each rod from its nodes `built` (about their centroids) to positions_.
+  void RotationsSince(const Model& model, const std::vector<Matrix3X>& built,
+                      RodRotations* q) const;
 
   std::unique_ptr<MobilityOperator> mobility_;
   std::vector<Matrix3X> positions_;  ///< at the last Prepare (the operator points into them)
@@ -169,6 +168,15 @@ class HydroCoupling {
   std::vector<Matrix3X> preconditioner_positions_;  ///< the rods' nodes when it was built,
                                                     ///< about their centroids
   RodRotations preconditioner_rotations_;           ///< R_k; empty: applied as built
+  // The matrix-free path's coarse level, kept across coarse_period_ builds of the preconditioner
+  // (CoarseRebuildPeriod): the rods' nodes about their centroids at its build, the rods'
+  // rotations since then (empty while it is the current build's), the builds that kept it, its h.
+  std::vector<Matrix3X> coarse_positions_;
+  RodRotations coarse_rotations_;
+  int builds_since_coarse_ = 0;
+  int coarse_period_ = 1;
+  double coarse_h_ = -1.0;
+  bool slowed_severely_ = false;  ///< the last solve took more than twice the rebuild's products
   int excess_products_ = 0;  ///< GMRES products beyond the first solve's since the rebuild
   long preconditioner_builds_ = 0;
   long krylov_total_ = 0;
@@ -188,6 +196,15 @@ void GatherNodeVelocities(const Model& model, const VecX& q, const VecX& q_start
 /// rods are split among the threads as a static OpenMP loop splits them, and each thread's rods
 /// are solved two at a time (SolveEach: bit for bit each rod's own Solve).
 void SolveRodsBanded(const Model& model, const std::vector<BandedMatrix>& jacobian, VecX* x);
+
+/// How many rebuilds of the block preconditioner one build of its coarse level serves, for
+/// `coarse_unknowns` (E's size) and M nodes (model.hydro.coarse_rebuild_period 0: by this). E's
+/// LU costs (2/3) n_c³ flops, a GMRES product O(M): the coarse rebuild in products grows as
+/// n_c³ / M (as R² for R rods), and with its staleness growing steadily from its build the
+/// period that minimizes rebuilds plus extra products goes as the square root of that cost:
+/// round(√(n_c³ / (κ M))), κ = kCoarseKeepScale, 1 at a hundred helices (where the age limit of
+/// 40 steps for both levels was measured to pay), 2 at two hundred, 4 at four hundred.
+int CoarseRebuildPeriod(int coarse_unknowns, int nodes);
 
 /// The mobility operator of the model: model.hydro.mobility's, with the bodies' points behind a
 /// matrix-free one (fluid/mobility_sources.h).

@@ -109,6 +109,10 @@ struct HydroOptions {
   /// GMRES: the kept preconditioner follows each rod's rotation since it was built
   /// (sim/hydro_coupling.h); false applies it as built (the reference).
   bool rotate_preconditioner = true;
+  /// Matrix-free: the coarse level is rebuilt at every this-many rebuilds of the preconditioner
+  /// (kept in its own frame between them, with rotate_preconditioner); 0: by its cost
+  /// (CoarseRebuildPeriod, sim/hydro_coupling.h).
+  int coarse_rebuild_period = 0;
 };
 
 struct Model {
