@@ -1,8 +1,9 @@
 // Nonlocal hydrodynamics (RSS, LSBT) inside the implicit Euler step (paper eqs. 16, 21, 22).
 //
 // The mobility 𝕄 (U = 𝕄 F, fluid/mobility_operator.h) is taken at q(t_k) and kept for the step.
-//   explicit (paper Algorithm 1): the drag f = −𝕄⁻¹ U(t_k), a constant force during the Newton
-//   solve; implicit (default):           the drag f on the rods is an unknown beside q, with
+//   explicit (paper Algorithm 1): the drag f = −𝕄⁻¹ U(t_k), a constant force during the
+//                                 Newton solve;
+//   implicit (default):           the drag f on the rods is an unknown beside q, with
 //                                 r_q = M(q − q_k − h v_k)/h² − F(q) − Sᵀ f = 0   (momentum)
 //                                 r_u = S(q − q_k)/h + 𝕄 f = 0                   (no slip)
 //                                 S the selection of the free position DOFs.
