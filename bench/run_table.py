@@ -37,8 +37,12 @@ ROD_COUNT = {"fig1_h1ms": 2, "fig1_h10ms": 2, "fig1_explicit": 2, "fig1_lsbt_N19
 # preconditioner is rebuilt at most every 40 steps (sim/hydro_coupling.cc), so a window of 40
 # holds about one rebuild (lattice100: steps 41, 81, ...; ~400 ms on one thread), which the
 # median leaves out and the mean, and so the seconds per simulated second, now carries.
+# From 2026-12-08 (session 39) the coarse level's E is rebuilt at every k-th rebuild only (k = 2 at
+# 200 helices, 4 at 400: sim/hydro_coupling.h CoarseRebuildPeriod), so the mean of those two
+# cases needs k x 40 timed steps to hold one whole cycle: 80 and 160 (a round of `large` then
+# takes about 5 minutes on 1 and 2 threads).
 DEFAULT_STEPS = {"lattice10": (60, 40), "lattice20": (60, 40), "lattice50": (60, 40),
-                 "lattice100": (60, 40), "lattice200": (60, 40), "lattice400": (60, 40)}
+                 "lattice100": (60, 40), "lattice200": (60, 80), "lattice400": (60, 160)}
 DEFAULT_WARMUP, DEFAULT_TIMED = 100, 50
 SCALING_CASES = ["lattice10", "lattice20", "lattice50", "lattice100"]
 # The growth at scale, when lattice200 or lattice400 ran: the fit from fifty on.
