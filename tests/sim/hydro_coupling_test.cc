@@ -62,17 +62,14 @@ struct TurnOutcome {
 // = `coarse_period` says (0: by its cost, 1 for two helices).
 TurnOutcome SolveBeforeAndAfterATurn(const std::string& mobility, bool rotate, double angle,
                                      bool aged = false, int coarse_period = 0) {
-  const Model model = testing::ModelFromToml(testing::SmallHelicesToml(
-      2, 17, 300,
-      "model = \"rss\"\nmobility = \"" + mobility + "\"\nsolver = \"krylov\"\n" +
-          std::string(mobility == "matrix_free"
-                          ? "far_field_tolerance = 1e-10\nfast_sum_tolerance = 1e-10\n"
-                          : "") +
-          "krylov_tolerance = 1e-10\nmobility_reuse_tolerance = 0\nkrylov_rotate_preconditioner "
-          "= " +
-          std::string(rotate ? "true" : "false") +
-          "\nkrylov_coarse_rebuild_period = " + std::to_string(coarse_period),
-      "time_step = 0.01"));
+  std::string fluid = "model = \"rss\"\nmobility = \"" + mobility + "\"\nsolver = \"krylov\"\n";
+  if (mobility == "matrix_free")
+    fluid += "far_field_tolerance = 1e-10\nfast_sum_tolerance = 1e-10\n";
+  fluid += "krylov_tolerance = 1e-10\nmobility_reuse_tolerance = 0\n";
+  fluid += "krylov_rotate_preconditioner = " + std::string(rotate ? "true" : "false") + "\n";
+  fluid += "krylov_coarse_rebuild_period = " + std::to_string(coarse_period);
+  const Model model =
+      testing::ModelFromToml(testing::SmallHelicesToml(2, 17, 300, fluid, "time_step = 0.01"));
   const double h = 0.01;
   State start = MakeRestState(model);
   {
