@@ -238,6 +238,7 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
                        preconditioner_h_ != h ||
                        preconditioner_age_ >= kPreconditionerMaxAge;
   if (rebuild) {
+    const bool same_h = preconditioner_h_ == h;  // also that of a kept coarse level
     have_preconditioner_ = true;
     preconditioner_h_ = h;
     preconditioner_age_ = 0;
@@ -245,7 +246,7 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
     excess_products_ = 0;
     ++preconditioner_builds_;
     preconditioner_rotations_ = RodRotations{};
-    if (rotate_preconditioner_ && krylov_) StartPreconditionerRotations(model);
+    if (rotate_preconditioner_ && krylov_) StartPreconditionerRotations();
     BuildSchurBlocks(model);
     if (block_preconditioner_) {
       std::vector<MatX> blocks(model.rods.size());
@@ -253,18 +254,19 @@ bool HydroCoupling::FactorizeNewtonSystem(const Model& model, double h,
         blocks[r] = h * mobility_->SelfBlock(static_cast<int>(r)) + sx_blocks_[r];
       // The coarse level is kept from an earlier build (in its own frame) for coarse_period_
       // builds, unless h changed or GMRES took more than twice its products after a rebuild.
-      const bool keep_coarse = rotate_preconditioner_ && !coarse_positions_.empty() &&
-                               coarse_h_ == h && !slowed_severely_ &&
-                               builds_since_coarse_ + 1 < coarse_period_;
+      const bool keep_coarse = rotate_preconditioner_ && !coarse_positions_.empty() && same_h &&
+                               !slowed_severely_ && builds_since_coarse_ + 1 < coarse_period_;
       if (!capacitance_blocks_.Build(model, h, blocks, MakeHydroRods(model, positions_), bodies_,
-                                     borders_, true, keep_coarse))
+                                     borders_, true, keep_coarse)) {
+        coarse_positions_.clear();  // a failed build's coarse level is not kept
         return have_preconditioner_ = false;
+      }
       if (keep_coarse) {
         ++builds_since_coarse_;
-        RotationsSince(model, coarse_positions_, &coarse_rotations_);
+        // Prepare turned it already where it was kept before this build too.
+        if (coarse_rotations_.empty()) RotationsSince(model, coarse_positions_, &coarse_rotations_);
       } else {
         builds_since_coarse_ = 0;
-        coarse_h_ = h;
         coarse_positions_ = preconditioner_positions_;
         coarse_rotations_ = RodRotations{};
         coarse_period_ =
@@ -343,19 +345,13 @@ void HydroCoupling::ApplyCapacitance(const Model& model, double h, const VecX& v
   if (borders_) ApplyClampBorders(model, h, *borders_, v, scratch_dofs_, out);
 }
 
-void HydroCoupling::StartPreconditionerRotations(const Model& model) {
-  // The rods' nodes about their centroids at the build, and where each rod's entries sit; the
-  // rotations themselves come with the next Prepare (none until then: built where it stands).
+void HydroCoupling::StartPreconditionerRotations() {
+  // The rods' nodes about their centroids at the build; the rotations (and where each rod's
+  // entries sit) come with the next Prepare (none until then: built where it stands).
   const std::size_t num_rods = positions_.size();
   preconditioner_positions_.resize(num_rods);
-  RodRotations& q = preconditioner_rotations_;
-  q.first_node.resize(num_rods);
-  q.nodes.resize(num_rods);
-  for (std::size_t r = 0; r < num_rods; ++r) {
+  for (std::size_t r = 0; r < num_rods; ++r)
     preconditioner_positions_[r] = positions_[r].colwise() - positions_[r].rowwise().mean();
-    q.first_node[r] = model.rods[r].node_offset;
-    q.nodes[r] = model.rods[r].num_nodes();
-  }
 }
 
 void HydroCoupling::UpdatePreconditionerRotations(const Model& model) {

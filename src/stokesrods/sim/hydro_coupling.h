@@ -136,8 +136,8 @@ class HydroCoupling {
   std::vector<ClampBorder>* borders_ = nullptr;  ///< of the last FactorizeNewtonSystem
   mutable VecX scratch_dofs_;
   void Precondition(const VecX& v, VecX* out) const;
-  // At a rebuild: the rods' nodes about their centroids, and the rotations' layout.
-  void StartPreconditionerRotations(const Model& model);
+  // At a rebuild: the rods' nodes about their centroids.
+  void StartPreconditionerRotations();
   // R_k of each rod since the preconditioner was built (see above), at every Prepare; and since
   // its coarse level was, where that one is kept from an earlier build.
   void UpdatePreconditionerRotations(const Model& model);
@@ -171,12 +171,12 @@ class HydroCoupling {
   RodRotations preconditioner_rotations_;           ///< R_k; empty: applied as built
   // The matrix-free path's coarse level, kept across coarse_period_ builds of the preconditioner
   // (CoarseRebuildPeriod): the rods' nodes about their centroids at its build, the rods'
-  // rotations since then (empty while it is the current build's), the builds that kept it, its h.
+  // rotations since then (empty while it is the current build's), the builds that kept it (its
+  // h is preconditioner_h_: a change of h rebuilds it).
   std::vector<Matrix3X> coarse_positions_;
   RodRotations coarse_rotations_;
   int builds_since_coarse_ = 0;
   int coarse_period_ = 1;
-  double coarse_h_ = -1.0;
   bool slowed_severely_ = false;  ///< the last solve took more than twice the rebuild's products
   int excess_products_ = 0;  ///< GMRES products beyond the first solve's since the rebuild
   long preconditioner_builds_ = 0;
